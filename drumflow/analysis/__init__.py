@@ -1,0 +1,1 @@
+"""Analysis: observables from dumps and the paper's heat-transfer methodology."""

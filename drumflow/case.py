@@ -1,0 +1,409 @@
+"""The validated case: the only place that knows the TOML case-file layout.
+
+A case describes one drum study: the drum and its lifters (flights), the particles, the contact
+laws, the air and how long and how finely to run. Units are SI unless the field name says
+otherwise (``tilt_deg``, ``rpm``, ``initial_temperature_C``, ``pressure_kPa``).
+
+Every problem in a case file is reported at once, each naming the field, the value and the
+allowed range (:class:`drumflow.errors.CaseError`), before any solver starts.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import tomllib
+from pathlib import Path
+from typing import Annotated, Any, Literal
+
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+
+from drumflow.errors import CaseError
+
+#: Bulk solids fraction of a settled bed of near-monodisperse spheres, used to turn a fill
+#: fraction (share of the drum volume taken by the bed) into a particle count.
+BED_SOLIDS_FRACTION = 0.6
+
+Positive = Annotated[float, Field(gt=0)]
+Fraction = Annotated[float, Field(ge=0, le=1)]
+
+
+class _Section(BaseModel):
+    # Unknown keys are errors: a typo such as ``diamter`` must not silently fall back to a
+    # default and produce a different drum than the user meant.
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class Drum(_Section):
+    """The drum shell (a section of the real cooler's length)."""
+
+    diameter: float = Field(gt=0, le=10, description="inner shell diameter, m")
+    length: float = Field(gt=0, le=30, description="simulated section length l along the axis, m")
+    tilt_deg: float = Field(1.5, ge=0, lt=30, description="axis tilt below horizontal, degrees")
+    rpm: float = Field(gt=0, le=60, description="rotation speed, revolutions per minute")
+    facet_size: float | Literal["auto"] = Field(
+        "auto", description="STL facet edge length, m; 'auto' picks it from drum and particle size"
+    )
+
+    @property
+    def radius(self) -> float:
+        return 0.5 * self.diameter
+
+    @property
+    def omega(self) -> float:
+        """Angular speed, rad/s."""
+        return self.rpm * 2.0 * math.pi / 60.0
+
+    @property
+    def froude(self) -> float:
+        """Rotational Froude number omega^2 R / g (1 = centrifuging)."""
+        return self.omega**2 * self.radius / 9.81
+
+
+class Lifters(_Section):
+    """Lifters (flights) welded to the shell, one profile for all, evenly spaced.
+
+    The profile is drawn in the drum cross-section: a radial base plate of height
+    ``base_height`` from the shell inwards, then (for ``angled`` and ``L``) a lip of length
+    ``lip_length`` at the base's tip, bent by ``lip_angle_deg`` from the base towards the
+    direction of rotation, so that the lifter holds material as it rises (the paper's
+    Figure 2 style). ``L`` means a lip at 90 degrees; ``straight`` has no lip.
+    """
+
+    count: int = Field(ge=0, le=64, description="number of lifters around the circumference")
+    profile: Literal["straight", "angled", "L"] = "L"
+    base_height: float = Field(gt=0, description="radial height of the base plate, m")
+    lip_length: float = Field(0.0, ge=0, description="length of the lip, m")
+    lip_angle_deg: float = Field(
+        90.0, ge=30, le=170, description="angle between base and lip, degrees (L: 90)"
+    )
+    thickness: float = Field(gt=0, description="plate thickness, m")
+
+
+class Particles(_Section):
+    """The granular material, as monodisperse spheres."""
+
+    diameter: float = Field(gt=0, le=0.2, description="sphere diameter, m")
+    density: float = Field(gt=0, le=20000, description="solid density, kg/m^3")
+    youngs_modulus: float = Field(gt=1e3, le=1e12, description="Young's modulus, Pa")
+    poisson_ratio: float = Field(gt=0, lt=0.5, description="Poisson's ratio")
+    heat_capacity: float = Field(gt=0, le=1e5, description="specific heat, J/(kg K)")
+    conductivity: float = Field(gt=0, le=1e4, description="thermal conductivity, W/(m K)")
+    count: int | None = Field(None, ge=1, le=50_000_000, description="number of particles")
+    fill_fraction: float | None = Field(
+        None, gt=0, le=0.5, description="share of the drum volume taken by the settled bed"
+    )
+    initial_temperature_C: float = Field(90.0, gt=-100, lt=1500)
+    initial_temperature_spread_C: float = Field(
+        0.0,
+        ge=0,
+        lt=1000,
+        description="half the particles start this much hotter than the other half "
+        "(mean unchanged); 0 = uniform feed. Used by conduction checks.",
+    )
+
+    @model_validator(mode="after")
+    def _count_or_fill(self) -> Particles:
+        if (self.count is None) == (self.fill_fraction is None):
+            raise ValueError(
+                "particles: give exactly one of 'count' (1 to 50,000,000) or "
+                "'fill_fraction' (0 to 0.5)"
+            )
+        return self
+
+    @property
+    def radius(self) -> float:
+        return 0.5 * self.diameter
+
+    @property
+    def volume(self) -> float:
+        return math.pi / 6.0 * self.diameter**3
+
+    @property
+    def mass(self) -> float:
+        return self.density * self.volume
+
+
+class Contact(_Section):
+    """One contact pair's coefficients (Hertz-Mindlin with rolling resistance)."""
+
+    friction: float = Field(ge=0, le=2, description="static (Coulomb) friction coefficient")
+    restitution: float = Field(gt=0.01, le=1, description="normal coefficient of restitution")
+    rolling_friction: float = Field(
+        0.05, ge=0, le=1, description="rolling friction coefficient (CDT model)"
+    )
+
+
+class Contacts(_Section):
+    particle_particle: Contact
+    particle_wall: Contact
+    wall_youngs_modulus: float | None = Field(
+        None,
+        gt=1e3,
+        le=1e12,
+        description="Young's modulus of shell and lifters, Pa; default: the particles' value, "
+        "so that wall contacts are as soft as particle contacts and do not set the time step",
+    )
+
+
+class Air(_Section):
+    """The cooling air (counter-current). Used by the air field and the exchanger model."""
+
+    model: Literal["none", "uniform", "cfd"] = Field(
+        "none", description="'none': no air (conduction only); 'uniform': plug flow; 'cfd': OpenFOAM"
+    )
+    mass_flow: float = Field(25.0, ge=0, le=1000, description="air mass flow, kg/s")
+    inlet_temperature_C: float = Field(30.0, gt=-60, lt=500)
+    pressure_kPa: float = Field(101.3, gt=10, lt=1000)
+    heat_capacity: float = Field(1005.0, gt=0, description="air specific heat, J/(kg K)")
+
+
+class Run(_Section):
+    """How long and how finely to simulate."""
+
+    time: float = Field(gt=0, le=3600, description="simulated time, s")
+    time_step: float | Literal["auto"] = Field("auto", description="DEM time step, s, or 'auto'")
+    rayleigh_fraction: float = Field(
+        0.2, gt=0, le=0.5, description="'auto' time step as a fraction of the Rayleigh time"
+    )
+    dump_interval: float = Field(
+        0.02,
+        gt=0,
+        description="output step of the observables, s: mean temperature and the crossing dump "
+        "(particles near the axis plane) are written this often (the paper's dt, Table 5)",
+    )
+    snapshot_interval: float = Field(
+        0.5, gt=0, description="time between full particle snapshots (pictures, checks), s"
+    )
+    mass_flow_start: float = Field(
+        1.0, ge=0, description="start of the falling-mass-flow window, s (paper: after 1 s)"
+    )
+    processes: int = Field(1, ge=1, le=1024, description="MPI processes")
+    seed: int = Field(5_489_317, ge=1, lt=2**31, description="random seed for insertion")
+    restart_interval: float = Field(
+        0.5, gt=0, description="time between restart files (resume after an interrupt), s"
+    )
+    neighbor_skin: float | Literal["auto"] = Field(
+        "auto", description="neighbour-list skin, m; 'auto' = 0.5 particle diameters"
+    )
+
+
+class Plant(_Section):
+    """The full-scale cooler the section stands for (exchanger model, predictions)."""
+
+    length: float = Field(19.0, gt=0, le=200, description="cooler length L, m")
+    material_mass_flow: float = Field(13.88889, gt=0, description="feed rate, kg/s")
+    material_inlet_temperature_C: float = Field(90.0, gt=-60, lt=1500)
+    material_outlet_temperature_C: float | None = Field(None, gt=-60, lt=1500)
+
+
+class Case(_Section):
+    """A complete drumflow case."""
+
+    name: str = Field(min_length=1, max_length=80, pattern=r"^[A-Za-z0-9_.-]+$")
+    description: str = ""
+    drum: Drum
+    lifters: Lifters
+    particles: Particles
+    contacts: Contacts
+    air: Air = Air()
+    run: Run
+    plant: Plant = Plant()
+
+    @model_validator(mode="after")
+    def _geometry_fits(self) -> Case:
+        problems: list[str] = []
+        R = self.drum.radius
+        d = self.particles.diameter
+        lf = self.lifters
+        if lf.base_height >= 0.5 * R:
+            problems.append(
+                f"lifters.base_height = {lf.base_height} m: must be below half the drum "
+                f"radius ({0.5 * R:g} m)"
+            )
+        if lf.profile == "straight" and lf.lip_length > 0:
+            problems.append(
+                f"lifters.lip_length = {lf.lip_length} m: a 'straight' lifter has no lip (use 0)"
+            )
+        if lf.profile != "straight" and lf.lip_length <= 0:
+            problems.append(
+                f"lifters.lip_length = {lf.lip_length} m: an '{lf.profile}' lifter needs a lip "
+                "longer than 0"
+            )
+        if lf.profile == "L" and abs(lf.lip_angle_deg - 90.0) > 1e-9:
+            problems.append(
+                f"lifters.lip_angle_deg = {lf.lip_angle_deg}: an 'L' lifter has a 90 degree lip "
+                "(use profile 'angled' for other angles)"
+            )
+        if lf.thickness >= lf.base_height:
+            problems.append(
+                f"lifters.thickness = {lf.thickness} m: must be below base_height "
+                f"({lf.base_height} m)"
+            )
+        if lf.count > 0:
+            # Free arc between neighbouring lifters at the tip radius: particles must fit
+            # through it, or they jam and the DEM run only measures a blocked drum.
+            from drumflow.geometry.lifters import lifter_gap
+
+            gap = lifter_gap(R, lf)
+            if gap < 3.0 * d:
+                problems.append(
+                    f"particles.diameter = {d} m: the gap between lifters is {gap:.4g} m and "
+                    f"must be at least 3 particle diameters ({3 * d:.4g} m); use fewer or "
+                    "smaller lifters or smaller particles"
+                )
+        if d > 0.25 * self.drum.length:
+            problems.append(
+                f"particles.diameter = {d} m: must be at most a quarter of drum.length "
+                f"({0.25 * self.drum.length:g} m) so that the section holds several layers"
+            )
+        if self.particles.count is not None and problems == []:
+            solids = self.particles.count * self.particles.volume
+            drum_volume = math.pi * R**2 * self.drum.length
+            if solids > 0.35 * drum_volume:
+                problems.append(
+                    f"particles.count = {self.particles.count}: the solids would take "
+                    f"{solids / drum_volume:.0%} of the drum volume; allowed up to 35% "
+                    f"(at most {int(0.35 * drum_volume / self.particles.volume)} particles)"
+                )
+        if self.drum.froude >= 1.0:
+            problems.append(
+                f"drum.rpm = {self.drum.rpm}: Froude number {self.drum.froude:.2f} >= 1, the bed "
+                f"centrifuges; allowed below {60 / (2 * math.pi) * math.sqrt(9.81 / R):.1f} rpm"
+            )
+        if isinstance(self.run.time_step, float) and self.run.time_step > self.run.dump_interval:
+            problems.append(
+                f"run.time_step = {self.run.time_step} s: must not exceed run.dump_interval "
+                f"({self.run.dump_interval} s)"
+            )
+        if self.run.snapshot_interval < self.run.dump_interval:
+            problems.append(
+                f"run.snapshot_interval = {self.run.snapshot_interval} s: must be at least "
+                f"run.dump_interval ({self.run.dump_interval} s)"
+            )
+        if self.run.dump_interval > 0.5 * self.run.time:
+            problems.append(
+                f"run.dump_interval = {self.run.dump_interval} s: must be at most half of "
+                f"run.time ({0.5 * self.run.time:g} s)"
+            )
+        if self.run.mass_flow_start >= self.run.time:
+            problems.append(
+                f"run.mass_flow_start = {self.run.mass_flow_start} s: must be below run.time "
+                f"({self.run.time} s)"
+            )
+        if problems:
+            raise ValueError("\n".join(problems))
+        return self
+
+    # -- derived quantities --------------------------------------------------------------
+    @property
+    def particle_count(self) -> int:
+        """The number of particles, from ``count`` or from ``fill_fraction``."""
+        if self.particles.count is not None:
+            return self.particles.count
+        assert self.particles.fill_fraction is not None
+        drum_volume = math.pi * self.drum.radius**2 * self.drum.length
+        solids = self.particles.fill_fraction * drum_volume * BED_SOLIDS_FRACTION
+        return max(1, round(solids / self.particles.volume))
+
+    @property
+    def particle_mass_total(self) -> float:
+        return self.particle_count * self.particles.mass
+
+    def canonical_json(self) -> str:
+        """The case as canonical JSON (sorted keys), the basis of its hash."""
+        return json.dumps(self.model_dump(mode="json"), sort_keys=True, separators=(",", ":"))
+
+    def hash(self) -> str:
+        """SHA-256 of the canonical case, identifying a run's inputs."""
+        return hashlib.sha256(self.canonical_json().encode()).hexdigest()
+
+    def section_hash(self, *sections: str) -> str:
+        """Hash of some sections only, e.g. ``("drum", "lifters")`` for the geometry cache."""
+        data = self.model_dump(mode="json")
+        sub = {s: data[s] for s in sections}
+        return hashlib.sha256(json.dumps(sub, sort_keys=True).encode()).hexdigest()
+
+
+def _format_error(err: dict[str, Any], loc: str) -> list[str]:
+    msg: str = err.get("msg", "")
+    value = err.get("input")
+    etype = err.get("type", "")
+    if etype == "value_error":
+        # Our own model validators already name field, value and range, one per line.
+        text = msg.removeprefix("Value error, ")
+        return [line for line in text.splitlines() if line]
+    if etype == "missing":
+        return [f"{loc}: missing (required)"]
+    if etype == "extra_forbidden":
+        return [f"{loc} = {value!r}: unknown field (check the spelling)"]
+    ctx = err.get("ctx") or {}
+    bounds = [f"{word} {ctx[key]}" for key, word in _BOUNDS if key in ctx]
+    allowed = f"; allowed: {' and '.join(bounds)}" if bounds else ""
+    return [f"{loc} = {value!r}: {msg[:1].lower()}{msg[1:]}{allowed}"]
+
+
+_BOUNDS = (("gt", ">"), ("ge", ">="), ("lt", "<"), ("le", "<="))
+
+
+def _clean_loc(err: dict[str, Any]) -> str:
+    # pydantic appends the union member tag ("float", "literal['auto']") to the location.
+    parts = [str(p) for p in err.get("loc", ())]
+    return ".".join(p for p in parts if p not in {"float", "int"} and not p.startswith("literal["))
+
+
+def _merge_problems(errors: list[dict[str, Any]]) -> list[str]:
+    """One line per mistake: a union field (float | "auto") fails once per member."""
+    grouped: dict[str, list[dict[str, Any]]] = {}
+    for err in errors:
+        grouped.setdefault(_clean_loc(err), []).append(err)
+    lines: list[str] = []
+    for loc, errs in grouped.items():
+        if len(errs) > 1 and all(e.get("type") != "value_error" for e in errs):
+            expected = " or ".join(sorted({e.get("msg", "") for e in errs}))
+            lines.append(f"{loc} = {errs[0].get('input')!r}: {expected[:1].lower()}{expected[1:]}")
+            continue
+        for err in errs:
+            lines.extend(_format_error(err, loc))
+    return lines
+
+
+def case_from_dict(data: dict[str, Any], source: Path | str | None = None) -> Case:
+    """Validate a case given as nested dictionaries.
+
+    Raises
+    ------
+    CaseError
+        Listing every problem, each with field, value and allowed range.
+    """
+    try:
+        return Case.model_validate(data)
+    except ValidationError as exc:
+        raise CaseError(_merge_problems(exc.errors()), source) from None
+
+
+def load_case(path: Path | str) -> Case:
+    """Read and validate a TOML case file.
+
+    Raises
+    ------
+    CaseError
+        When the file is missing, is not valid TOML, or has invalid values.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise CaseError([f"case file {path}: not found"], path)
+    try:
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
+    except tomllib.TOMLDecodeError as exc:
+        raise CaseError([f"not valid TOML: {exc}"], path) from None
+    return case_from_dict(data, source=path)
+
+
+def case_to_toml(case: Case) -> str:
+    """Write a case back as TOML (used for the copy kept in each run directory)."""
+    import tomli_w
+
+    data = case.model_dump(mode="json", exclude_none=True)
+    return tomli_w.dumps(data)

@@ -1,0 +1,188 @@
+"""DEM stage: LIGGGHTS deck, particle placement, the run itself, and resuming it.
+
+The deck is rendered from ``templates/drum.in.j2``; the run goes through
+:class:`drumflow.runner.Runner` under ``mpirun``. An interrupted run restarts from its newest
+LIGGGHTS restart file; a finished run is reused.
+"""
+
+from __future__ import annotations
+
+import re
+import time
+from collections.abc import Callable
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from drumflow.dem.deck import DeckFiles, deck_context, plan_steps, render_deck, short_plan
+from drumflow.dem.placement import place_particles, write_data_file
+from drumflow.dem.thermo import ThermoParser
+from drumflow.dem.timestep import choose_time_step
+from drumflow.errors import LostParticlesError, SolverError
+from drumflow.rundir import hash_text
+
+if TYPE_CHECKING:
+    from drumflow.case import Case
+    from drumflow.geometry import GeometryResult
+    from drumflow.rundir import RunDir
+    from drumflow.runner import Runner
+
+__all__ = ["DemResult", "ThermoParser", "run_dem", "dem_key"]
+
+#: progress(stage, done, total): simulated seconds done out of the total.
+ProgressCallback = Callable[[str, float, float], None]
+
+_LOST_RE = re.compile(r"Lost atoms: original (\d+) current (\d+)")
+
+
+@dataclass(frozen=True)
+class DemResult:
+    time_step: float
+    steps: int
+    dump_every: int
+    snapshot_every: int
+    particles_initial: int
+    particles_final: int
+    wall_time_s: float
+    particle_steps_per_s: float
+    resumed_from_step: int | None
+    time_step_choice: dict
+    log: str
+
+
+def dem_key(case: Case, steps: int | None) -> str:
+    """What the DEM stage depends on: the whole case, and a short-run step limit."""
+    return case.hash() + (f":steps={steps}" if steps else "")
+
+
+def _latest_restart(folder: Path) -> tuple[Path, int] | None:
+    best: tuple[Path, int] | None = None
+    for p in folder.glob("drum.*.restart"):
+        m = re.search(r"drum\.(\d+)\.restart$", p.name)
+        if m and (best is None or int(m.group(1)) > best[1]):
+            best = (p, int(m.group(1)))
+    return best
+
+
+def run_dem(
+    case: Case,
+    rundir: RunDir,
+    runner: Runner,
+    geometry: GeometryResult,
+    progress: ProgressCallback | None = None,
+    steps: int | None = None,
+    timeout: float | None = None,
+    extra_commands: str = "",
+) -> DemResult:
+    """Run (or resume, or reuse) the DEM stage.
+
+    Parameters
+    ----------
+    steps
+        Stop after this many DEM steps (a short start-up check of a large case).
+    timeout
+        Wall-clock limit for LIGGGHTS, s.
+    extra_commands
+        LIGGGHTS lines run just before the main run (verification and stress scenes); they
+        are part of the stage key.
+
+    Raises
+    ------
+    LostParticlesError
+        Particles left the domain.
+    SolverError
+        LIGGGHTS failed otherwise.
+    """
+    key = dem_key(case, steps) + (f":extra={hash_text(extra_commands)}" if extra_commands else "")
+    done = rundir.stage_done("dem", key)
+    if done:
+        return DemResult(**done["result"])
+    work = rundir.dem
+    (work / "dumps").mkdir(parents=True, exist_ok=True)
+    (work / "restart").mkdir(parents=True, exist_ok=True)
+    choice = choose_time_step(case)
+    plan = plan_steps(case, choice)
+    if steps is not None:
+        plan = short_plan(plan, steps)
+    n = case.particle_count
+    resume = None
+    if steps is None and rundir.manifest.get("dem_key") == key:
+        resume = _latest_restart(work / "restart")
+    if resume is None:
+        for old in (work / "dumps").glob("*.txt"):
+            old.unlink()
+        for old in [*(work / "restart").glob("*.restart"), *work.glob("log.resume-*.liggghts")]:
+            old.unlink()
+        positions = place_particles(case, n)
+        write_data_file(case, positions, work / "particles.data", (geometry.box_lo, geometry.box_hi))
+    rundir.record("dem_key", key)
+    files = DeckFiles(stl_file=str(Path("..") / geometry.stl))
+    context = deck_context(
+        case,
+        plan,
+        files,
+        resume_from=None if resume is None else str(resume[0].relative_to(work)),
+        extra_commands=extra_commands,
+    )
+    deck_name = "in.drum" if resume is None else "in.drum.resume"
+    (work / deck_name).write_text(render_deck(context))
+    rundir.record("time_step", choice.as_dict())
+
+    total = plan.steps * plan.time_step
+    parser = ThermoParser(
+        on_time=(lambda t, _n: progress("dem", min(t, total), total)) if progress else None
+    )
+    # LIGGGHTS writes (and flushes) its own log, which feeds the progress bar; the runner
+    # keeps standard output separately.
+    suffix = "" if resume is None else f".resume-{resume[1]}"
+    own_log = work / f"log{suffix}.liggghts"
+    log = work / f"liggghts{suffix}.out"
+    if own_log.exists():
+        own_log.unlink()
+
+    def check(returncode: int, lines: list[str]) -> str | None:
+        lost = next((ln for ln in reversed(lines) if _LOST_RE.search(ln)), None)
+        if lost:
+            return lost.strip()
+        if not any(line.startswith("Loop time") for line in lines):
+            return "LIGGGHTS stopped before finishing its run loop"
+        return None
+
+    command = runner.profile.mpi_command(
+        ["liggghts", "-in", deck_name, "-log", own_log.name], case.run.processes
+    )
+    t0 = time.perf_counter()
+    try:
+        runner.run(
+            "liggghts", command, work, log, timeout=timeout, on_line=parser, check=check,
+            follow=own_log,
+        )
+    except SolverError as err:
+        lost = _LOST_RE.search(f"{err.reason} {err.last_error}")
+        if lost:
+            raise LostParticlesError(int(lost.group(1)), int(lost.group(2)), log, command) from None
+        raise
+    finally:
+        rundir.record_commands([r.as_dict() for r in runner.records if r.program == "liggghts"][-1:])
+    wall = time.perf_counter() - t0
+    final_atoms = int(parser.rows[-1][2]) if parser.rows else n
+    if final_atoms != n:
+        # `thermo_modify lost error` should have stopped the run; this is a second line of
+        # defence, e.g. against a deck edited by hand.
+        raise LostParticlesError(n, final_atoms, log, command)
+    steps_run = plan.steps - (resume[1] if resume else 0)
+    result = DemResult(
+        time_step=plan.time_step,
+        steps=plan.steps,
+        dump_every=plan.dump_every,
+        snapshot_every=plan.snapshot_every,
+        particles_initial=n,
+        particles_final=final_atoms,
+        wall_time_s=wall,
+        particle_steps_per_s=n * steps_run / wall if wall > 0 else 0.0,
+        resumed_from_step=None if resume is None else resume[1],
+        time_step_choice=choice.as_dict(),
+        log=str(log.relative_to(rundir.root)),
+    )
+    rundir.mark_done("dem", key, asdict(result), wall)
+    return result

@@ -1,0 +1,182 @@
+"""Render the LIGGGHTS input deck from ``templates/`` for a case.
+
+The template knows LIGGGHTS' syntax; this module only computes the values that go into it
+(material tables, gravity vector, step counts), so the physics stays testable without a solver.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import jinja2
+
+from drumflow.dem.timestep import TimeStepChoice
+
+if TYPE_CHECKING:
+    from drumflow.case import Case
+
+#: Young's modulus below which LIGGGHTS 3.8 needs ``soft_particles yes``.
+SOFT_PARTICLE_LIMIT = 5.0e6
+
+
+def templates_dir() -> Path:
+    """The folder with the deck templates (``DRUMFLOW_TEMPLATES`` overrides it)."""
+    env = os.environ.get("DRUMFLOW_TEMPLATES")
+    if env:
+        return Path(env)
+    return Path(__file__).resolve().parents[2] / "templates"
+
+
+def _environment() -> jinja2.Environment:
+    return jinja2.Environment(
+        loader=jinja2.FileSystemLoader(str(templates_dir())),
+        undefined=jinja2.StrictUndefined,  # a missing value is an error, never an empty string
+        keep_trailing_newline=True,
+        trim_blocks=True,
+        lstrip_blocks=True,
+    )
+
+
+@dataclass(frozen=True)
+class DeckFiles:
+    """Paths the deck refers to, relative to the DEM working directory."""
+
+    data_file: str = "particles.data"
+    stl_file: str = "../geometry/walls.stl"
+    cross_pattern: str = "dumps/cross.*.txt"
+    snapshot_pattern: str = "dumps/snap.*.txt"
+    restart_pattern: str = "restart/drum.*.restart"
+    final_restart: str = "restart/final.restart"
+
+
+@dataclass(frozen=True)
+class StepPlan:
+    """How the simulated time maps onto DEM steps."""
+
+    time_step: float
+    steps: int
+    dump_every: int  # crossing dump and thermo (mean temperature) output
+    snapshot_every: int
+    restart_every: int
+
+    @property
+    def dump_interval(self) -> float:
+        return self.dump_every * self.time_step
+
+
+def plan_steps(case: Case, choice: TimeStepChoice) -> StepPlan:
+    """Step counts for the run; output intervals are whole multiples of the output step."""
+    dt = choice.time_step
+    dump_every = max(1, round(case.run.dump_interval / dt))
+    # A whole number of output steps, so that the last output falls on the last step.
+    steps = math.ceil(case.run.time / dt / dump_every - 1e-9) * dump_every
+
+    def multiple(interval: float) -> int:
+        return max(dump_every, round(interval / dt / dump_every) * dump_every)
+
+    return StepPlan(dt, steps, dump_every, multiple(case.run.snapshot_interval),
+                    multiple(case.run.restart_interval))
+
+
+def short_plan(plan: StepPlan, steps: int) -> StepPlan:
+    """A plan for only ``steps`` steps (start-up check): output at its end, no restarts."""
+    every = min(plan.dump_every, steps)
+    return StepPlan(plan.time_step, steps, every, min(plan.snapshot_every, steps), 0)
+
+
+def crossing_band(case: Case, plan: StepPlan) -> float:
+    """Half-width of the crossing dump's band around y = 0, m.
+
+    Wider than the farthest a particle moves in one output step (free fall across the drum
+    plus the wall speed, with 50% margin), plus a diameter.
+    """
+    v_max = math.sqrt(2.0 * 9.81 * case.drum.diameter) + case.drum.omega * case.drum.radius
+    return 1.5 * v_max * plan.dump_every * plan.time_step + case.particles.diameter
+
+
+def gravity_vector(tilt_deg: float) -> tuple[float, float, float]:
+    """Unit gravity direction in drum coordinates: down in y, and along +z by the tilt."""
+    t = math.radians(tilt_deg)
+    return (0.0, -math.cos(t), math.sin(t))
+
+
+def processors_grid(case: Case) -> str:
+    """MPI decomposition: along the axis for long sections, across it for thin slices."""
+    n = case.run.processes
+    if n == 1:
+        return "1 1 1"
+    if case.drum.length >= case.drum.diameter:
+        return f"1 1 {n}"
+    # A thin slice holds its bed at the bottom: splitting left/right balances the load.
+    return f"{n} 1 1"
+
+
+def neighbor_skin(case: Case) -> float:
+    """Neighbour-list skin, m (half a particle diameter unless the case sets it)."""
+    if case.run.neighbor_skin == "auto":
+        return 0.5 * case.particles.diameter
+    return float(case.run.neighbor_skin)
+
+
+def deck_context(
+    case: Case,
+    plan: StepPlan,
+    files: DeckFiles = DeckFiles(),
+    resume_from: str | None = None,
+    extra_commands: str = "",
+) -> dict[str, Any]:
+    """All values the template needs.
+
+    ``extra_commands`` are LIGGGHTS lines placed just before the run (verification scenes).
+    """
+    p = case.particles
+    cc = case.contacts
+    E_wall = cc.wall_youngs_modulus if cc.wall_youngs_modulus is not None else p.youngs_modulus
+    return {
+        "case_name": case.name,
+        "processors": processors_grid(case),
+        "soft_particles": min(p.youngs_modulus, E_wall) < SOFT_PARTICLE_LIMIT,
+        "resume": resume_from is not None,
+        "restart_file": resume_from or "",
+        "data_file": files.data_file,
+        "skin": f"{neighbor_skin(case):.6g}",
+        "E_particle": f"{p.youngs_modulus:.9g}",
+        "E_wall": f"{E_wall:.9g}",
+        "nu_particle": f"{p.poisson_ratio:.6g}",
+        "nu_wall": f"{p.poisson_ratio:.6g}",
+        "e_pp": f"{cc.particle_particle.restitution:.6g}",
+        "e_pw": f"{cc.particle_wall.restitution:.6g}",
+        "mu_pp": f"{cc.particle_particle.friction:.6g}",
+        "mu_pw": f"{cc.particle_wall.friction:.6g}",
+        "mur_pp": f"{cc.particle_particle.rolling_friction:.6g}",
+        "mur_pw": f"{cc.particle_wall.rolling_friction:.6g}",
+        "k_particle": f"{p.conductivity:.9g}",
+        "cp_particle": f"{p.heat_capacity:.9g}",
+        "dt": f"{plan.time_step:.9g}",
+        "gravity": [f"{g:.9f}" for g in gravity_vector(case.drum.tilt_deg)],
+        "stl_file": files.stl_file,
+        "length": f"{case.drum.length:.9g}",
+        "period": f"{60.0 / case.drum.rpm:.9g}",
+        "T0": p.initial_temperature_C,
+        "temperature_spread": p.initial_temperature_spread_C,
+        "thermo_every": plan.dump_every,
+        "dump_every": plan.dump_every,
+        "snapshot_every": plan.snapshot_every,
+        "cross_pattern": files.cross_pattern,
+        "snapshot_pattern": files.snapshot_pattern,
+        "band": f"{crossing_band(case, plan):.6g}",
+        "restart_every": plan.restart_every,
+        "restart_pattern": files.restart_pattern,
+        "final_restart": files.final_restart,
+        "steps": plan.steps,
+        "extra_commands": extra_commands,
+    }
+
+
+def render_deck(context: dict[str, Any], template: str = "drum.in.j2") -> str:
+    """Render a deck template with :class:`jinja2.StrictUndefined` (missing values raise)."""
+    return _environment().get_template(template).render(**context)

@@ -1,0 +1,1 @@
+"""Report stage: plots (matplotlib PNG) of a run's observables."""

@@ -1,0 +1,68 @@
+"""Deck rendering: the physics values land in the LIGGGHTS commands."""
+
+from __future__ import annotations
+
+import math
+
+import jinja2
+import pytest
+
+from drumflow.case import case_from_dict
+from drumflow.dem.deck import (
+    DeckFiles,
+    deck_context,
+    gravity_vector,
+    plan_steps,
+    render_deck,
+)
+from drumflow.dem.timestep import choose_time_step
+
+
+def _deck(d: dict, **kw) -> str:
+    case = case_from_dict(d)
+    plan = plan_steps(case, choose_time_step(case))
+    return render_deck(deck_context(case, plan, DeckFiles(), **kw))
+
+
+def test_deck_has_the_models(smoke_dict: dict) -> None:
+    deck = _deck(smoke_dict)
+    assert "pair_style      gran model hertz tangential history rolling_friction cdt" in deck
+    assert "heat/gran/conduction initial_temperature 90" in deck
+    assert "fix spin all move/mesh mesh shell rotate origin 0. 0. 0. axis 0. 0. 1. period 4" in deck
+    assert "coefficientFriction peratomtypepair 2 0.4 0.2 0.2 0.2" in deck
+    assert "coefficientRestitution peratomtypepair 2 0.1 0.3 0.3 0.3" in deck
+    assert "thermo_modify   lost error" in deck
+    assert "soft_particles" not in deck  # 5 MPa is not soft
+    assert "read_data       particles.data" in deck
+    assert "{{" not in deck and "{%" not in deck
+
+
+def test_soft_particles_and_resume(smoke_dict: dict) -> None:
+    smoke_dict["particles"]["youngs_modulus"] = 517e3
+    deck = _deck(smoke_dict, resume_from="restart/drum.100.restart")
+    assert "soft_particles  yes" in deck
+    assert "read_restart    restart/drum.100.restart" in deck
+    assert "read_data" not in deck
+
+
+def test_gravity_tilt() -> None:
+    g = gravity_vector(1.5)
+    assert g[2] == pytest.approx(math.sin(math.radians(1.5)))
+    assert math.hypot(*g) == pytest.approx(1.0)
+
+
+def test_strict_undefined(smoke_dict: dict) -> None:
+    case = case_from_dict(smoke_dict)
+    plan = plan_steps(case, choose_time_step(case))
+    ctx = deck_context(case, plan)
+    del ctx["period"]
+    with pytest.raises(jinja2.UndefinedError):
+        render_deck(ctx)
+
+
+def test_step_plan_rounds_intervals(smoke_dict: dict) -> None:
+    case = case_from_dict(smoke_dict)
+    choice = choose_time_step(case)
+    plan = plan_steps(case, choice)
+    assert plan.steps * plan.time_step >= case.run.time
+    assert abs(plan.dump_interval - case.run.dump_interval) <= 0.5 * plan.time_step

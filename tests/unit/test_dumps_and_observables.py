@@ -1,0 +1,122 @@
+"""Dump parsing and the paper's observables on data whose answer is known."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from drumflow.analysis.observables import (
+    escaped_particles,
+    falling_mass_flow,
+    falling_mass_per_interval,
+    find_crossings,
+    mean_temperature,
+)
+from drumflow.dem.dumps import read_dump, read_rows, read_series
+from drumflow.errors import RunDirectoryError
+
+DUMP = """ITEM: TIMESTEP
+{step}
+ITEM: NUMBER OF ATOMS
+{n}
+ITEM: BOX BOUNDS ff ff ff
+-0.2 0.2
+-0.2 0.2
+0 0.1
+ITEM: ATOMS id x y z vx vy vz radius f_Temp[0] 
+{rows}"""
+
+
+def _write(folder: Path, step: int, rows: list[tuple], prefix: str = "snap") -> None:
+    body = "".join(" ".join(str(v) for v in r) + " \n" for r in rows)
+    (folder / f"{prefix}.{step:010d}.txt").write_text(DUMP.format(step=step, n=len(rows), rows=body))
+
+
+def test_read_hand_written_dump(tmp_path: Path) -> None:
+    _write(tmp_path, 100, [(2, 0.1, 0.2, 0.3, 0, 0, -1, 0.004, 80.5), (1, -0.1, 0.0, 0.05, 0, 0, 0, 0.004, 90.0)])
+    snap = read_dump(tmp_path / "snap.0000000100.txt")
+    assert snap.step == 100
+    assert snap.ids.tolist() == [1, 2]  # sorted by id
+    assert snap.columns["T"].tolist() == [90.0, 80.5]
+    assert snap.columns["vz"].tolist() == [0.0, -1.0]
+
+
+def test_truncated_dump_is_an_error(tmp_path: Path) -> None:
+    p = tmp_path / "snap.0000000001.txt"
+    p.write_text(DUMP.format(step=1, n=3, rows="1 0 0 0 0 0 0 0.004 90 \n"))
+    with pytest.raises(RunDirectoryError, match="header says 3 particles"):
+        read_dump(p)
+
+
+def test_series_marks_lost_particles_nan(tmp_path: Path) -> None:
+    _write(tmp_path, 0, [(1, 0, 0.1, 0, 0, 0, 0, 0.004, 90), (2, 0, 0.1, 0, 0, 0, 0, 0.004, 70)])
+    _write(tmp_path, 10, [(2, 0, -0.1, 0, 0, 0, 0, 0.004, 71)])
+    s = read_series(tmp_path, time_step=0.001)
+    assert s.counts.tolist() == [2, 1]
+    assert np.isnan(s["T"][1, 0]) and s["T"][1, 1] == 71
+    assert s.times.tolist() == [0.0, 0.01]
+
+
+def test_crossings_of_free_fall() -> None:
+    # 50 particles released from y = 0.1 at known times fall freely; each crosses y = 0 once
+    # at t_release + sqrt(2 * 0.1 / g). Dumps every 2 ms: interpolation error is below
+    # (g dt^2 / 8) / v, about 3 microseconds here, so 1e-4 s is a safe tolerance.
+    g, dt = 9.81, 0.002
+    times = np.arange(0, 1.0 + dt / 2, dt)
+    release = np.linspace(0.05, 0.8, 50)
+    tau = times[:, None] - release[None, :]
+    y = np.where(tau > 0, 0.1 - 0.5 * g * tau**2, 0.1)
+    x = np.zeros_like(y)
+    z = np.tile(np.linspace(0.0, 0.1, 50), (len(times), 1))
+    ids = np.arange(1, 51)
+    table = find_crossings(times, ids, x, y, z)
+    assert len(table) == 50
+    expected = np.sort(release + np.sqrt(2 * 0.1 / g))
+    assert np.allclose(table["time"], expected, atol=1e-4)
+    assert np.allclose(np.sort(table["z"]), np.linspace(0, 0.1, 50))
+    # Upward motion is not counted: reverse time.
+    assert len(find_crossings(times, ids, x, y[::-1], z)) == 0
+
+
+def test_falling_mass_flow_eq57() -> None:
+    t = np.array([0.5, 1.0, 1.5, 2.0, 3.0])
+    table = pd.DataFrame({"time": t, "id": np.arange(5), "x": [0, 0, 0.19, 0, 0], "z": 0.0})
+    flow = falling_mass_flow(table, particle_mass=0.002, start=1.0, curtain_radius=0.1)
+    # Four crossings from 1.0 s to 3.0 s: 4 * 2 g / 2 s = 4 g/s; one of them is near the wall.
+    assert flow.crossings == 4
+    assert flow.mass_flow_kg_s == pytest.approx(0.004)
+    assert flow.curtain_mass_flow_kg_s == pytest.approx(0.003)
+    per = falling_mass_per_interval(table, np.array([0.0, 1.25, 2.5, 3.5]), 0.002)
+    assert per.tolist() == pytest.approx([0.004, 0.004, 0.002])
+    assert falling_mass_flow(table.iloc[:1], 0.002).mass_flow_kg_s == 0.0
+
+
+def test_mean_temperature_is_mass_weighted() -> None:
+    T = np.array([[10.0, 20.0], [np.nan, 30.0]])
+    m = np.array([1.0, 3.0])
+    assert mean_temperature(T, m).tolist() == pytest.approx([17.5, 30.0])
+
+
+def test_escaped_particles() -> None:
+    x = np.array([[0.0, 0.0, 0.3], [0.0, 0.0, 0.3]])
+    y = np.array([[0.0, 0.199, 0.0], [0.0, 0.25, 0.0]])
+    assert escaped_particles(x, y, radius=0.2, particle_radius=0.004) == 2
+
+
+def test_crossings_from_band_dumps(tmp_path: Path) -> None:
+    """Particles enter and leave the band: a crossing needs both sides in consecutive dumps."""
+    row = lambda i, y, z=0.05: (i, 0.0, y, z, 0, 0, 0, 0.004, 90)  # noqa: E731
+    _write(tmp_path, 0, [row(1, 0.03), row(2, 0.02)], "cross")
+    _write(tmp_path, 10, [row(1, -0.01), row(3, 0.01)], "cross")  # 1 crosses; 2 left the band
+    _write(tmp_path, 20, [row(2, -0.02), row(3, -0.03, 0.07)], "cross")  # 2 skipped a dump
+    rows = read_rows(tmp_path, time_step=0.001, prefix="cross")
+    from drumflow.analysis.observables import crossings_from_rows
+
+    table = crossings_from_rows(rows.times, rows.frame, rows.ids, rows["x"], rows["y"], rows["z"])
+    assert table["id"].tolist() == [1, 3]
+    # Particle 1: y 0.03 -> -0.01 over 0.01 s crosses at 3/4 of the interval.
+    assert table["time"].tolist() == pytest.approx([0.0075, 0.0125])
+    assert table["z"].iloc[1] == pytest.approx(0.05 + 0.25 * 0.02)
