@@ -120,11 +120,8 @@ def run(
         err_console.print(f"interrupted; run the same command again to resume into {out}")
         raise typer.Exit(130) from None
     _print_summary(summary, out, as_json)
-    if summary.get("particles_escaped_through_walls", 0):
-        err_console.print(
-            f"[bold red]failed:[/] {summary['particles_escaped_through_walls']} particles leaked "
-            "through the walls (see summary.json)"
-        )
+    if summary.get("status", "ok") != "ok":
+        err_console.print(f"[bold red]{summary['status']}[/] (see {out}/summary.json)")
         raise typer.Exit(1)
 
 

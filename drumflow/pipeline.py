@@ -165,11 +165,18 @@ def post_run(out: Path | str, case: Case | None = None) -> dict[str, Any]:
                    post / "particles_final.png", f"{title}, t = {snaps.times[-1]:.2f} s",
                    time_s=float(snaps.times[-1]))
 
+    final = int(thermo["atoms"].iloc[-1])
+    problems = []
+    if final != case.particle_count:
+        problems.append(f"{case.particle_count - final} particles left the domain")
+    if escaped:
+        problems.append(f"{escaped} particles escaped through the walls")
     summary: dict[str, Any] = {
         "case": case.name,
+        "status": "ok" if not problems else "failed: " + "; ".join(problems),
         "case_hash": case.hash(),
         "particles_initial": case.particle_count,
-        "particles_final": int(thermo["atoms"].iloc[-1]),
+        "particles_final": final,
         "particles_escaped_through_walls": escaped,
         "simulated_time_s": float(times[-1]),
         "mean_temperature_C": float(T_mean[-1]),

@@ -18,7 +18,7 @@ from drumflow.dem.deck import DeckFiles, deck_context, plan_steps, render_deck, 
 from drumflow.dem.placement import place_particles, write_data_file
 from drumflow.dem.thermo import ThermoParser
 from drumflow.dem.timestep import choose_time_step
-from drumflow.errors import LostParticlesError, SolverError
+from drumflow.errors import InsertionError, LostParticlesError, SolverError
 from drumflow.rundir import hash_text
 
 if TYPE_CHECKING:
@@ -165,6 +165,10 @@ def run_dem(
     finally:
         rundir.record_commands([r.as_dict() for r in runner.records if r.program == "liggghts"][-1:])
     wall = time.perf_counter() - t0
+    first_atoms = int(parser.rows[0][2]) if parser.rows else 0
+    if resume is None and first_atoms != n:
+        # read_data silently skips atoms outside the box: the count must be exact at step 0.
+        raise InsertionError(n, first_atoms, "LIGGGHTS read fewer particles than were placed")
     final_atoms = int(parser.rows[-1][2]) if parser.rows else n
     if final_atoms != n:
         # `thermo_modify lost error` should have stopped the run; this is a second line of

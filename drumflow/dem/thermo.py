@@ -75,8 +75,15 @@ def read_thermo(dem_dir: Path) -> pd.DataFrame:
             frames.append(frame)
     if not frames:
         return pd.DataFrame(columns=list(COLUMNS))
-    table = pd.concat(frames, ignore_index=True)
-    # A resumed run repeats the steps after its restart file; keep the resumed values.
+    # A resumed attempt supersedes everything earlier attempts wrote from its restart step on,
+    # including the off-grid line an interrupted LIGGGHTS prints when it stops.
+    kept = []
+    for k, frame in enumerate(frames):
+        later_starts = [f["step"].iloc[0] for f in frames[k + 1 :]]
+        cut = min(later_starts) if later_starts else np.inf
+        kept.append(frame[frame["step"] < cut])
+    table = pd.concat(kept, ignore_index=True)
+    # `run 0` at the very end repeats the last step: keep one row per step.
     table = table.sort_values(["step", "attempt"]).drop_duplicates("step", keep="last")
     table["step"] = table["step"].astype(np.int64)
     table["atoms"] = table["atoms"].astype(np.int64)

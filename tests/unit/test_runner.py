@@ -64,3 +64,19 @@ def test_profile_mpi_command_and_root_env() -> None:
 def test_last_error_line() -> None:
     assert last_error_line(["ok", "ERROR: a", "fine", "assertion failed (x.h:1)"]) == "assertion failed (x.h:1)"
     assert last_error_line(["ok"]) is None
+
+
+def test_follow_reads_the_programs_own_log_while_it_runs(tmp_path: Path) -> None:
+    """Progress comes from a file the program flushes (LIGGGHTS' log), not its buffered stdout."""
+    seen: list[tuple[float, str]] = []
+    t0 = time.time()
+    script = (
+        "for i in 1 2 3; do echo step $i >> own.log; sleep 0.6; done; echo stdout-only"
+    )
+    Runner().run("sh", ["sh", "-c", script], tmp_path, tmp_path / "out.txt",
+                 on_line=lambda line: seen.append((time.time() - t0, line.strip())),
+                 follow=tmp_path / "own.log")
+    assert [line for _, line in seen] == ["step 1", "step 2", "step 3"]
+    # The first line arrived while the program was still running (it runs ~1.8 s).
+    assert seen[0][0] < 1.2
+    assert "stdout-only" in (tmp_path / "out.txt").read_text()

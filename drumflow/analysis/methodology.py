@@ -1,0 +1,739 @@
+"""The paper's methodology applied to a run directory (Sections 2.2-2.5, Tables 6-8).
+
+Burgos-Florez et al., Processes 2019, 7, 673. From the files a finished ``drumflow run`` leaves
+behind, this module computes:
+
+1. the heat-transfer coefficient of every output step, Eqs. 34-41
+   (:func:`~drumflow.analysis.heat_transfer.per_step_heat_transfer`), and its time average
+   (Table 6);
+2. the per-step Nusselt, Reynolds and Prandtl numbers, Eqs. 49-55
+   (:func:`~drumflow.analysis.dimensionless.dimensionless_numbers`);
+3. the whole cooler as a counter-current exchanger, Eqs. 42-48 (Table 7): the exchange area
+   ``A_he`` from the simulated section (Eq. 46 with ``L / l``), then the material outlet
+   temperature for the mean ``h`` (:func:`~drumflow.analysis.exchanger.solve_outlet_temperature`),
+   and, when the case gives the plant's measured outlet temperature, the area the plant needs
+   at this ``h`` (the paper's "industry cooler" column);
+4. across runs, the ``Nu = a Re^b Pr^c`` fit with its ANOVA, Eq. 56 and Table 8
+   (:func:`fit_runs`).
+
+Inputs read: ``DIR/case.toml`` and ``DIR/post/mean_temperature.csv`` (columns ``time_s``,
+``mean_temperature_C``, ``particles``, ``falling_mass_kg_in_step``; the falling mass of the step
+ending at each row, NaN in the first row). :func:`analyse_run` writes nothing;
+:func:`write_methodology` writes ``DIR/post/methodology.json`` and ``DIR/post/steps.csv``.
+
+Falling mass (``m_mf`` in Eqs. 35, 41 and 46). The paper writes it with a bar, "the average NPK
+mass that falls during one time step", and Table 6 gives one value per model, measured after the
+first second (Section 3.3). The default ``falling_mass="mean"`` does the same: it takes the mean
+falling mass flow of the steps that start at or after ``run.mass_flow_start`` and gives every step
+that flow times its length. ``falling_mass="per_step"`` uses each step's own crossing mass instead.
+That is noisier, because the mass is a whole number of particles, and steps in which no particle
+fell are masked, since Eq. 41 then has no area.
+
+The average ``h`` covers every valid step of the simulated time, as the paper says in Section 2.2.
+Steps that start before ``run.mass_flow_start`` are included. Only the falling mass is measured
+in that window.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Iterable, Mapping
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import Any, Literal
+
+import numpy as np
+import pandas as pd
+from numpy.typing import NDArray
+
+from drumflow.analysis._validate import AnalysisInputError
+from drumflow.analysis.correlation import NusseltCorrelation, fit_nusselt_correlation_from_runs
+from drumflow.analysis.dimensionless import dimensionless_numbers
+from drumflow.analysis.exchanger import (
+    ExchangerResult,
+    InfeasibleExchangerError,
+    area_for_outlet_temperature,
+    exchanger_area_from_section,
+    solve_outlet_temperature,
+)
+from drumflow.analysis.heat_transfer import falling_particle_area, per_step_heat_transfer
+from drumflow.case import Case, load_case
+from drumflow.errors import RunDirectoryError
+
+__all__ = [
+    "CASE_FILE",
+    "MEAN_TEMPERATURE_FILE",
+    "METHODOLOGY_FILE",
+    "STEPS_FILE",
+    "FallingMassMode",
+    "MethodologyResult",
+    "MissingRunFileError",
+    "NoHeatTransferError",
+    "NusseltConductivity",
+    "analyse_run",
+    "fit_runs",
+    "plant_streams",
+    "write_methodology",
+]
+
+FallingMassMode = Literal["mean", "per_step"]
+NusseltConductivity = Literal["air", "particle"]
+
+CASE_FILE = "case.toml"
+"""The validated case, relative to the run directory."""
+MEAN_TEMPERATURE_FILE = "post/mean_temperature.csv"
+"""Mean particle temperature and falling mass per output step, relative to the run directory."""
+METHODOLOGY_FILE = "post/methodology.json"
+"""Written by :func:`write_methodology`."""
+STEPS_FILE = "post/steps.csv"
+"""Per-step table written by :func:`write_methodology`."""
+
+_CSV_COLUMNS = ("time_s", "mean_temperature_C", "particles", "falling_mass_kg_in_step")
+
+# Mask reasons of the per-step table ("" for a valid step).
+_NO_CHANGE = "no_temperature_change"
+_CROSS = "temperature_cross"
+_NO_FALL = "no_falling_mass"
+
+# Tolerance when comparing a step's start time with run.mass_flow_start: output times are
+# multiples of the DEM time step (~1e-5 s) written with 10 significant digits, so they can sit a
+# few 1e-10 s off the nominal value. 1e-9 s is far below any DEM time step.
+_TIME_EPS_S = 1e-9
+
+
+class MissingRunFileError(RunDirectoryError):
+    """A file the methodology needs is not in the run directory.
+
+    Parameters
+    ----------
+    path
+        The missing file (absolute).
+    what
+        What the file holds, for the message.
+
+    Attributes
+    ----------
+    path
+        The missing file.
+    """
+
+    def __init__(self, path: Path, what: str) -> None:
+        self.path = path
+        super().__init__(
+            f"{path}: missing ({what}); run `drumflow run CASE --out DIR` (or `drumflow post DIR` "
+            "if the dumps are there) first"
+        )
+
+
+class NoHeatTransferError(RunDirectoryError):
+    """The run cannot give a heat-transfer coefficient (no air, no cooling, no falling mass)."""
+
+
+def plant_streams(
+    case: Case,
+    *,
+    feed_rate_kg_s: float | None = None,
+    air_mass_flow_kg_s: float | None = None,
+) -> dict[str, float]:
+    """Keyword arguments of the exchanger functions for the case's plant (Eqs. 42-48).
+
+    Parameters
+    ----------
+    case
+        The case; its ``plant`` section gives the material stream, ``air`` the air stream and
+        ``particles.heat_capacity`` the material specific heat.
+    feed_rate_kg_s
+        Material mass flow to use instead of ``plant.material_mass_flow``.
+    air_mass_flow_kg_s
+        Air mass flow to use instead of ``air.mass_flow``.
+
+    Returns
+    -------
+    dict
+        ``material_mass_flow_kg_s``, ``material_cp_j_kgk``, ``material_inlet_temperature_c``,
+        ``air_mass_flow_kg_s``, ``air_cp_j_kgk``, ``air_inlet_temperature_c``.
+    """
+    return {
+        "material_mass_flow_kg_s": float(
+            case.plant.material_mass_flow if feed_rate_kg_s is None else feed_rate_kg_s
+        ),
+        "material_cp_j_kgk": float(case.particles.heat_capacity),
+        "material_inlet_temperature_c": float(case.plant.material_inlet_temperature_C),
+        "air_mass_flow_kg_s": float(
+            case.air.mass_flow if air_mass_flow_kg_s is None else air_mass_flow_kg_s
+        ),
+        "air_cp_j_kgk": float(case.air.heat_capacity),
+        "air_inlet_temperature_c": float(case.air.inlet_temperature_C),
+    }
+
+
+@dataclass(frozen=True)
+class MethodologyResult:
+    """The methodology applied to one run (Tables 6 and 7, the per-step data of Figure 9).
+
+    Attributes
+    ----------
+    run_dir
+        The run directory (absolute).
+    case
+        The validated case of the run.
+    steps
+        One row per output step ``t -> t + dt``. Columns: ``time_s`` (end of the step), ``dt_s``,
+        ``mean_temperature_C`` (at the end), ``particle_dT_K`` (Eq. 34),
+        ``falling_mass_in_step_kg`` (as written by the run), ``falling_mass_kg`` (the ``m_mf``
+        used), ``air_mass_kg``, ``heat_J`` (Eq. 35), ``air_dT_K`` (Eq. 36),
+        ``air_temperature_C`` (Eq. 37), ``lmtd_K`` (Eq. 38), ``heat_rate_W`` (Eq. 40),
+        ``area_fp_m2`` (Eq. 41), ``h_W_m2K`` (Eq. 39), ``valid``, ``mask`` (why a step is not
+        valid: ``no_temperature_change``, ``temperature_cross`` or ``no_falling_mass``),
+        ``in_mass_flow_window``, ``mean_air_temperature_C`` (Eq. 50), ``reynolds`` (Eq. 51),
+        ``prandtl``, ``nusselt`` (Eq. 49), ``conductivity_W_mK``. The dimensionless columns are
+        NaN on invalid steps.
+    h_mean_w_m2k
+        Time average of ``h`` over the valid steps (Table 6).
+    falling_mass_mode
+        ``"mean"`` or ``"per_step"`` (see the module notes).
+    falling_mass_flow_kg_s
+        Mean falling mass flow in the window (Eq. 57 from the per-step masses).
+    falling_mass_window_s
+        ``(start, end)`` of the steps the mean falling mass flow was taken over.
+    dt_s
+        Mean output step (s), the paper's ``dt``.
+    falling_mass_per_step_kg
+        ``falling_mass_flow_kg_s * dt_s``, Table 6's ``m_mf``.
+    air_mass_per_step_kg
+        ``air.mass_flow * dt_s``, Table 6's ``m_a``.
+    falling_area_m2
+        Eq. 41 for ``falling_mass_per_step_kg``, Table 6's ``A_fp``.
+    nusselt_conductivity
+        ``"air"`` (air conductivity at ``T_ma``) or ``"particle"`` (``particles.conductivity``,
+        what reproduces the paper's Nusselt numbers).
+    void_fraction, air_inlet_velocity_m_s, max_air_velocity_m_s
+        Eqs. 53, the mean air inlet velocity and Eq. 52.
+    exchanger_area_m2
+        ``A_he`` of the whole cooler, Eq. 46 with ``L / l``.
+    exchanger
+        The cooler with ``h_mean`` and ``A_he`` (Table 7, model column): ``T_mo``, ``T_ao``,
+        ``Q_m``, ``LMTD_he``, ``Q_he``.
+    plant_exchanger
+        When ``plant.material_outlet_temperature_C`` is set: the area the plant needs to reach it
+        with ``h_mean`` (Table 7, industry column); else None (also None when that temperature is
+        infeasible for the streams, with a warning).
+    warnings
+        Remarks on the analysis (e.g. the falling-mass window fell back to all steps).
+    """
+
+    run_dir: Path
+    case: Case
+    steps: pd.DataFrame
+    h_mean_w_m2k: float
+    falling_mass_mode: str
+    falling_mass_flow_kg_s: float
+    falling_mass_window_s: tuple[float, float]
+    dt_s: float
+    falling_mass_per_step_kg: float
+    air_mass_per_step_kg: float
+    falling_area_m2: float
+    nusselt_conductivity: str
+    void_fraction: float
+    air_inlet_velocity_m_s: float
+    max_air_velocity_m_s: float
+    exchanger_area_m2: float
+    exchanger: ExchangerResult
+    plant_exchanger: ExchangerResult | None
+    warnings: tuple[str, ...] = field(default=())
+
+    # -- per-step arrays (NaN on invalid steps), so the result can be fitted directly -------
+    @property
+    def nusselt(self) -> NDArray[np.float64]:
+        """Per-step Nusselt numbers (NaN on invalid steps)."""
+        return self.steps["nusselt"].to_numpy(dtype=np.float64)
+
+    @property
+    def reynolds(self) -> NDArray[np.float64]:
+        """Per-step Reynolds numbers (NaN on invalid steps)."""
+        return self.steps["reynolds"].to_numpy(dtype=np.float64)
+
+    @property
+    def prandtl(self) -> NDArray[np.float64]:
+        """Per-step Prandtl numbers (NaN on invalid steps)."""
+        return self.steps["prandtl"].to_numpy(dtype=np.float64)
+
+    @property
+    def n_steps(self) -> int:
+        """Number of output steps."""
+        return int(len(self.steps))
+
+    @property
+    def n_valid(self) -> int:
+        """Number of steps with a defined ``h``."""
+        return int(self.steps["valid"].sum())
+
+    @property
+    def masked(self) -> dict[str, int]:
+        """Number of invalid steps per reason."""
+        counts = self.steps.loc[~self.steps["valid"], "mask"].value_counts()
+        return {str(k): int(v) for k, v in counts.items()}
+
+    def _valid_stat(self, column: str, how: str) -> float:
+        values = self.steps.loc[self.steps["valid"], column].to_numpy(dtype=np.float64)
+        return float(getattr(np, how)(values)) if values.size else math.nan
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready summary (NaN written as ``null``); the per-step table is not included.
+
+        Returns
+        -------
+        dict
+            Sections ``settings``, ``heat_transfer`` (Table 6), ``dimensionless``, ``exchanger``
+            (Table 7) and ``warnings``.
+        """
+        case = self.case
+        k_used: float | str = (
+            float(case.particles.conductivity)
+            if self.nusselt_conductivity == "particle"
+            else "air at T_ma"
+        )
+        data: dict[str, Any] = {
+            "run_dir": str(self.run_dir),
+            "case": case.name,
+            "case_hash": case.hash(),
+            "settings": {
+                "falling_mass": self.falling_mass_mode,
+                "nusselt_conductivity": self.nusselt_conductivity,
+                "conductivity_W_mK": k_used,
+            },
+            "heat_transfer": {
+                "particle_diameter_mm": case.particles.diameter * 1e3,
+                "dt_s": self.dt_s,
+                "air_mass_kg": self.air_mass_per_step_kg,
+                "falling_mass_kg": self.falling_mass_per_step_kg,
+                "falling_mass_flow_kg_s": self.falling_mass_flow_kg_s,
+                "falling_mass_window_s": list(self.falling_mass_window_s),
+                "area_fp_m2": self.falling_area_m2,
+                "h_mean_W_m2K": self.h_mean_w_m2k,
+                "h_std_W_m2K": self._valid_stat("h_W_m2K", "std"),
+                "n_steps": self.n_steps,
+                "n_valid": self.n_valid,
+                "masked": self.masked,
+            },
+            "dimensionless": {
+                "void_fraction": self.void_fraction,
+                "air_inlet_velocity_m_s": self.air_inlet_velocity_m_s,
+                "max_air_velocity_m_s": self.max_air_velocity_m_s,
+                "reynolds_mean": self._valid_stat("reynolds", "mean"),
+                "reynolds_min": self._valid_stat("reynolds", "min"),
+                "reynolds_max": self._valid_stat("reynolds", "max"),
+                "prandtl_mean": self._valid_stat("prandtl", "mean"),
+                "nusselt_mean": self._valid_stat("nusselt", "mean"),
+            },
+            "exchanger": {
+                "cooler_length_m": case.plant.length,
+                "section_length_m": case.drum.length,
+                "area_he_m2": self.exchanger_area_m2,
+                "model": exchanger_to_dict(self.exchanger),
+                "plant": None
+                if self.plant_exchanger is None
+                else exchanger_to_dict(self.plant_exchanger),
+            },
+            "warnings": list(self.warnings),
+        }
+        return _json_safe(data)
+
+
+def exchanger_to_dict(result: ExchangerResult) -> dict[str, float]:
+    """An :class:`~drumflow.analysis.exchanger.ExchangerResult` as a flat dict (with the residual)."""
+    out = asdict(result)
+    out["balance_residual_w"] = result.balance_residual_w
+    return out
+
+
+def _json_safe(value: Any) -> Any:
+    # json.dumps writes NaN as a bare NaN token, which is not JSON; use null instead.
+    if isinstance(value, Mapping):
+        return {str(k): _json_safe(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_json_safe(v) for v in value]
+    if isinstance(value, (np.floating, float)):
+        f = float(value)
+        return f if math.isfinite(f) else None
+    if isinstance(value, np.integer):
+        return int(value)
+    if isinstance(value, np.bool_):
+        return bool(value)
+    return value
+
+
+def _read_mean_temperature(path: Path) -> pd.DataFrame:
+    try:
+        table = pd.read_csv(path)
+    except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
+        raise RunDirectoryError(f"{path}: not a readable CSV table ({exc})") from None
+    missing = [c for c in _CSV_COLUMNS if c not in table.columns]
+    if missing:
+        raise RunDirectoryError(
+            f"{path}: missing column(s) {', '.join(missing)}; expected the header "
+            f"{','.join(_CSV_COLUMNS)} (rerun `drumflow post DIR`)"
+        )
+    if len(table) < 2:
+        raise RunDirectoryError(
+            f"{path}: {len(table)} row(s); at least two output times are needed for one step"
+        )
+    for col in ("time_s", "mean_temperature_C"):
+        values = pd.to_numeric(table[col], errors="coerce").to_numpy(dtype=np.float64)
+        bad = ~np.isfinite(values)
+        if bad.any():
+            row = int(np.flatnonzero(bad)[0])
+            raise RunDirectoryError(
+                f"{path}: column {col} has a missing or non-numeric value in data row {row + 1}"
+            )
+    falling = pd.to_numeric(table["falling_mass_kg_in_step"], errors="coerce").to_numpy(
+        dtype=np.float64
+    )
+    # The first row has no step before it (NaN by design); every later one must be a mass.
+    bad = ~np.isfinite(falling[1:]) | (falling[1:] < 0.0)
+    if bad.any():
+        row = int(np.flatnonzero(bad)[0]) + 2
+        raise RunDirectoryError(
+            f"{path}: falling_mass_kg_in_step in data row {row} is "
+            f"{falling[row - 1]!r}; expected a mass >= 0 kg (only the first row may be empty)"
+        )
+    return table
+
+
+def _falling_window(
+    t: NDArray[np.float64], start_s: float
+) -> tuple[NDArray[np.bool_], list[str]]:
+    # Step k runs from t[k] to t[k+1]; it is in the window when it starts at or after start_s.
+    in_window = t[:-1] >= start_s - _TIME_EPS_S
+    notes: list[str] = []
+    if not in_window.any():
+        in_window = np.ones(t.size - 1, dtype=bool)
+        notes.append(
+            f"the run ends ({t[-1]:g} s) before run.mass_flow_start ({start_s:g} s): the mean "
+            "falling mass was taken over every step, including the settling of the initial fill"
+        )
+    return in_window, notes
+
+
+def analyse_run(
+    run_dir: Path | str,
+    *,
+    nusselt_conductivity: NusseltConductivity = "air",
+    falling_mass: FallingMassMode = "mean",
+) -> MethodologyResult:
+    """Apply the paper's methodology to one run directory (Tables 6 and 7, Eqs. 34-55).
+
+    Parameters
+    ----------
+    run_dir
+        A directory written by ``drumflow run`` (needs ``case.toml`` and
+        ``post/mean_temperature.csv``).
+    nusselt_conductivity
+        Conductivity in ``Nu = h Dp / k`` (Eq. 49): ``"air"`` (default, air at ``T_ma``, the usual
+        particle Nusselt number) or ``"particle"`` (``particles.conductivity``, which is what
+        reproduces the paper's Nusselt numbers; see :mod:`drumflow.analysis.dimensionless`).
+    falling_mass
+        ``"mean"`` (default, the paper's averaged ``m_mf``) or ``"per_step"``; see the module
+        notes.
+
+    Returns
+    -------
+    MethodologyResult
+
+    Raises
+    ------
+    MissingRunFileError
+        If ``case.toml`` or ``post/mean_temperature.csv`` is missing (the message names it).
+    NoHeatTransferError
+        If the run cannot give ``h``: it had no air (``air.model = "none"`` or no air flow), no
+        particle fell in the window, or no step is valid (the mean temperature never changed,
+        or every step was a temperature cross), or the mean ``h`` is not positive.
+    RunDirectoryError
+        If the CSV is malformed or the plant streams are inconsistent (the message names the
+        file).
+    drumflow.errors.CaseError
+        If ``case.toml`` is not a valid case.
+    ValueError
+        If ``nusselt_conductivity`` or ``falling_mass`` is not one of the allowed values.
+    """
+    if nusselt_conductivity not in ("air", "particle"):
+        raise AnalysisInputError("nusselt_conductivity", nusselt_conductivity, "'air' or 'particle'")
+    if falling_mass not in ("mean", "per_step"):
+        raise AnalysisInputError("falling_mass", falling_mass, "'mean' or 'per_step'")
+    root = Path(run_dir).resolve()
+    if not root.is_dir():
+        raise RunDirectoryError(f"{root}: not a directory (expected a `drumflow run` directory)")
+    case_path = root / CASE_FILE
+    csv_path = root / MEAN_TEMPERATURE_FILE
+    if not case_path.is_file():
+        raise MissingRunFileError(case_path, "the validated case of the run")
+    if not csv_path.is_file():
+        raise MissingRunFileError(csv_path, "mean particle temperature and falling mass per step")
+    case = load_case(case_path)
+
+    if case.air.model == "none" or case.air.mass_flow <= 0.0:
+        why = (
+            "air.model = 'none'"
+            if case.air.model == "none"
+            else f"air.mass_flow = {case.air.mass_flow:g} kg/s"
+        )
+        raise NoHeatTransferError(
+            f"{case_path}: the run had no air ({why}), so h cannot be measured: without air the "
+            "mean particle temperature changes only by conduction between particles, and "
+            "Eqs. 34-39 need the air to take the heat. Rerun with air.model = 'uniform' or 'cfd' "
+            "and air.mass_flow > 0."
+        )
+
+    table = _read_mean_temperature(csv_path)
+    t = table["time_s"].to_numpy(dtype=np.float64)
+    temp = table["mean_temperature_C"].to_numpy(dtype=np.float64)
+    per_step_mass = table["falling_mass_kg_in_step"].to_numpy(dtype=np.float64)[1:]
+    dt = np.diff(t)
+    if np.any(dt <= 0.0):
+        row = int(np.flatnonzero(dt <= 0.0)[0]) + 2
+        raise RunDirectoryError(f"{csv_path}: time_s is not increasing at data row {row}")
+    n = dt.size
+
+    in_window, notes = _falling_window(t, case.run.mass_flow_start)
+    window_mass = float(per_step_mass[in_window].sum())
+    window_time = float(dt[in_window].sum())
+    window = (float(t[:-1][in_window][0]), float(t[1:][in_window][-1]))
+    if window_mass <= 0.0:
+        raise NoHeatTransferError(
+            f"{csv_path}: no particle fell through the axis plane between {window[0]:g} s and "
+            f"{window[1]:g} s (falling_mass_kg_in_step is 0), so the falling-particle area "
+            "(Eq. 41) is zero and h cannot be measured; check the lifters and the rotation speed"
+        )
+    flow = window_mass / window_time
+    dt_mean = float(np.mean(dt))
+
+    dp = case.particles.diameter
+    rho = case.particles.density
+    streams = {
+        "material_cp_j_kgk": case.particles.heat_capacity,
+        "air_mass_flow_kg_s": case.air.mass_flow,
+        "air_cp_j_kgk": case.air.heat_capacity,
+        "air_inlet_temperature_c": case.air.inlet_temperature_C,
+    }
+    no_fall = np.zeros(n, dtype=bool)
+    try:
+        if falling_mass == "mean":
+            used_mass = flow * dt
+            steps = per_step_heat_transfer(
+                t, temp, particle_diameter_m=dp, particle_density_kg_m3=rho,
+                falling_mass_flow_kg_s=flow, **streams,
+            )
+        else:
+            no_fall = per_step_mass <= 0.0
+            # per_step_heat_transfer needs a positive mass everywhere; steps where nothing fell
+            # get a placeholder and are masked below (Eq. 41 gives them no area).
+            placeholder = np.where(no_fall, 1.0, per_step_mass)
+            used_mass = np.where(no_fall, 0.0, per_step_mass)
+            steps = per_step_heat_transfer(
+                t, temp, particle_diameter_m=dp, particle_density_kg_m3=rho,
+                falling_mass_kg=placeholder, **streams,
+            )
+    except AnalysisInputError as exc:
+        raise RunDirectoryError(f"{csv_path} with {case_path}: {exc}") from exc
+
+    h = np.array(steps.h_w_m2k, dtype=np.float64)
+    heat = np.array(steps.heat_j, dtype=np.float64)
+    air_dt = np.array(steps.air_dT_c, dtype=np.float64)
+    air_t = np.array(steps.air_temperature_c, dtype=np.float64)
+    lmtd = np.array(steps.lmtd_c, dtype=np.float64)
+    rate = np.array(steps.heat_rate_w, dtype=np.float64)
+    area = np.array(steps.area_m2, dtype=np.float64)
+    mask = np.full(n, "", dtype=object)
+    mask[steps.particle_dT_c == 0.0] = _NO_CHANGE
+    mask[(mask == "") & ~np.isfinite(steps.lmtd_c)] = _CROSS
+    if no_fall.any():
+        # Eq. 35 with m_mf = 0: no heat reaches the air and there is no area; h is undefined.
+        heat[no_fall] = 0.0
+        air_dt[no_fall] = 0.0
+        air_t[no_fall] = case.air.inlet_temperature_C
+        rate[no_fall] = 0.0
+        area[no_fall] = 0.0
+        lmtd[no_fall] = np.nan
+        h[no_fall] = np.nan
+        mask[no_fall] = _NO_FALL
+    valid = np.isfinite(h)
+    n_valid = int(valid.sum())
+
+    if n_valid == 0:
+        counts = {r: int((mask == r).sum()) for r in (_NO_CHANGE, _CROSS, _NO_FALL)}
+        if counts[_NO_CHANGE] == n:
+            why = (
+                f"the mean particle temperature never changed ({temp[0]:g} deg C throughout): "
+                "the air took no heat"
+            )
+        else:
+            why = ", ".join(f"{v} step(s) {k.replace('_', ' ')}" for k, v in counts.items() if v)
+        raise NoHeatTransferError(f"{csv_path}: no valid step of {n}, so h cannot be measured: {why}")
+
+    h_mean = float(np.sum(h[valid] * dt[valid]) / np.sum(dt[valid]))
+    if not h_mean > 0.0:
+        raise NoHeatTransferError(
+            f"{csv_path}: the mean h over {n_valid} valid step(s) is {h_mean:.4g} W/(m2 K), not "
+            "positive: the particles did not cool on average, so the cooler model cannot be "
+            "applied"
+        )
+
+    k = case.particles.conductivity if nusselt_conductivity == "particle" else None
+    try:
+        numbers = dimensionless_numbers(
+            h[valid],
+            air_t[valid],
+            air_inlet_temperature_c=case.air.inlet_temperature_C,
+            particle_diameter_m=dp,
+            drum_diameter_m=case.drum.diameter,
+            section_length_m=case.drum.length,
+            particle_count=case.particle_count,
+            air_mass_flow_kg_s=case.air.mass_flow,
+            conductivity_w_mk=k,
+        )
+    except AnalysisInputError as exc:
+        raise RunDirectoryError(f"{csv_path} with {case_path}: {exc}") from exc
+
+    def scatter(values: NDArray[np.float64]) -> NDArray[np.float64]:
+        out = np.full(n, np.nan)
+        out[valid] = values
+        return out
+
+    table_out = pd.DataFrame(
+        {
+            "time_s": t[1:],
+            "dt_s": dt,
+            "mean_temperature_C": temp[1:],
+            "particle_dT_K": np.asarray(steps.particle_dT_c),
+            "falling_mass_in_step_kg": per_step_mass,
+            "falling_mass_kg": used_mass,
+            "air_mass_kg": np.asarray(steps.air_mass_kg),
+            "heat_J": heat,
+            "air_dT_K": air_dt,
+            "air_temperature_C": air_t,
+            "lmtd_K": lmtd,
+            "heat_rate_W": rate,
+            "area_fp_m2": area,
+            "h_W_m2K": h,
+            "valid": valid,
+            "mask": mask.astype(str),
+            "in_mass_flow_window": in_window,
+            "mean_air_temperature_C": scatter(numbers.mean_air_temperature_c),
+            "reynolds": scatter(numbers.reynolds),
+            "prandtl": scatter(numbers.prandtl),
+            "nusselt": scatter(numbers.nusselt),
+            "conductivity_W_mK": scatter(numbers.conductivity_w_mk),
+        }
+    )
+
+    m_mf = flow * dt_mean
+    a_fp = float(falling_particle_area(m_mf, dp, rho))
+    a_he = exchanger_area_from_section(
+        a_fp, cooler_length_m=case.plant.length, section_length_m=case.drum.length, dt_s=dt_mean
+    )
+    plant = plant_streams(case)
+    try:
+        model = solve_outlet_temperature(h_w_m2k=h_mean, area_m2=a_he, **plant)
+    except AnalysisInputError as exc:
+        raise RunDirectoryError(f"{case_path}: the plant streams do not make a cooler: {exc}") from exc
+    plant_result: ExchangerResult | None = None
+    if case.plant.material_outlet_temperature_C is not None:
+        try:
+            plant_result = area_for_outlet_temperature(
+                h_w_m2k=h_mean,
+                material_outlet_temperature_c=case.plant.material_outlet_temperature_C,
+                **plant,
+            )
+        except InfeasibleExchangerError as exc:
+            notes.append(f"plant.material_outlet_temperature_C: {exc}")
+
+    return MethodologyResult(
+        run_dir=root,
+        case=case,
+        steps=table_out,
+        h_mean_w_m2k=h_mean,
+        falling_mass_mode=falling_mass,
+        falling_mass_flow_kg_s=flow,
+        falling_mass_window_s=window,
+        dt_s=dt_mean,
+        falling_mass_per_step_kg=m_mf,
+        air_mass_per_step_kg=case.air.mass_flow * dt_mean,
+        falling_area_m2=a_fp,
+        nusselt_conductivity=nusselt_conductivity,
+        void_fraction=numbers.void_fraction,
+        air_inlet_velocity_m_s=numbers.air_inlet_velocity_m_s,
+        max_air_velocity_m_s=numbers.max_air_velocity_m_s,
+        exchanger_area_m2=a_he,
+        exchanger=model,
+        plant_exchanger=plant_result,
+        warnings=tuple(notes),
+    )
+
+
+def write_methodology(run_dir: Path | str, result: MethodologyResult) -> tuple[Path, Path]:
+    """Write ``post/methodology.json`` and ``post/steps.csv`` into the run directory.
+
+    Parameters
+    ----------
+    run_dir
+        The run directory (its ``post/`` folder is created if missing).
+    result
+        The result of :func:`analyse_run` for this directory.
+
+    Returns
+    -------
+    tuple of pathlib.Path
+        The JSON file and the CSV file.
+    """
+    root = Path(run_dir).resolve()
+    json_path = root / METHODOLOGY_FILE
+    csv_path = root / STEPS_FILE
+    json_path.parent.mkdir(parents=True, exist_ok=True)
+    json_path.write_text(json.dumps(result.to_dict(), indent=2, allow_nan=False) + "\n")
+    result.steps.to_csv(csv_path, index=False, float_format="%.10g")
+    return json_path, csv_path
+
+
+def fit_runs(
+    run_dirs: Iterable[Path | str | MethodologyResult],
+    *,
+    nusselt_conductivity: NusseltConductivity = "air",
+    falling_mass: FallingMassMode = "mean",
+    **fit_kwargs: Any,
+) -> NusseltCorrelation:
+    """Fit ``Nu = a Re^b Pr^c`` (Eq. 56, Table 8) to the valid steps of several runs.
+
+    Parameters
+    ----------
+    run_dirs
+        Run directories, or results of :func:`analyse_run` (not analysed again; then the two
+        options below are not used for them).
+    nusselt_conductivity, falling_mass
+        Passed to :func:`analyse_run` for the directories.
+    **fit_kwargs
+        Passed to :func:`~drumflow.analysis.correlation.fit_nusselt_correlation`.
+        ``drop_nonpositive`` defaults to True here: a step in which the mean temperature rose
+        has a negative ``h`` (it is kept in the paper's average) but cannot enter a power law.
+
+    Returns
+    -------
+    NusseltCorrelation
+
+    Raises
+    ------
+    AnalysisInputError
+        If there is no run, or the data cannot identify the exponents (e.g. one run only: Re then
+        varies only through the air viscosity; combine runs with different particle diameters or
+        air flows).
+    RunDirectoryError
+        If a directory cannot be analysed (see :func:`analyse_run`).
+    """
+    results = [
+        r
+        if isinstance(r, MethodologyResult)
+        else analyse_run(r, nusselt_conductivity=nusselt_conductivity, falling_mass=falling_mass)
+        for r in run_dirs
+    ]
+    fit_kwargs.setdefault("drop_nonpositive", True)
+    return fit_nusselt_correlation_from_runs(results, **fit_kwargs)

@@ -1,0 +1,151 @@
+"""Real LIGGGHTS runs of a tiny drum (0.2 m, 500 particles): no mocks.
+
+Marked ``solver``; each test has a time limit. They need /usr/bin/liggghts and mpirun
+(scripts/install.sh installs both).
+"""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from conftest import tiny_case_dict
+from drumflow.case import case_from_dict, load_case
+from drumflow.dem import run_dem
+from drumflow.dem.dumps import read_series
+from drumflow.errors import LostParticlesError, SolverTimeoutError
+from drumflow.geometry import build_geometry
+from drumflow.pipeline import post_run, run_case
+from drumflow.rundir import RunDir
+from drumflow.runner import Runner
+
+pytestmark = [
+    pytest.mark.solver,
+    pytest.mark.skipif(shutil.which("liggghts") is None, reason="LIGGGHTS not installed (scripts/install.sh)"),
+]
+ROOT = Path(__file__).resolve().parents[2]
+
+
+@pytest.fixture(scope="module")
+def conduction_run(tmp_path_factory: pytest.TempPathFactory) -> tuple[dict, Path]:
+    """Conduction only, adiabatic walls, no air; left half of the bed starts 20 K hotter.
+
+    The conductivity is a metal's (100 W/m K) rather than NPK's 0.186, so that a lot of heat
+    flows in 1.2 s and the conservation check below is tested under real fluxes.
+    """
+    case = case_from_dict(
+        tiny_case_dict(particles__initial_temperature_spread_C=20.0, particles__conductivity=100.0)
+    )
+    out = tmp_path_factory.mktemp("tiny") / "run"
+    summary = run_case(case, out, timeout=300)
+    return summary, out
+
+
+@pytest.mark.timeout(400)
+def test_particle_count_is_conserved(conduction_run: tuple[dict, Path]) -> None:
+    summary, out = conduction_run
+    assert summary["particles_initial"] == summary["particles_final"] == 500
+    assert summary["particles_escaped_through_walls"] == 0
+    thermo = pd.read_csv(out / "post" / "mean_temperature.csv")
+    assert (thermo["particles"] == 500).all()
+
+
+@pytest.mark.timeout(400)
+def test_mean_temperature_is_conserved_by_conduction(conduction_run: tuple[dict, Path]) -> None:
+    """Heat is only exchanged between particles: the mass-weighted mean cannot move.
+
+    heat/gran/conduction adds each pair's flux to one particle and takes it from the other,
+    and all particles have the same m cp, so the mean is conserved to round-off; the thermo
+    output carries 12 significant digits (1e-10 K at 90 C). 1e-7 K leaves room for the sum of
+    ~1e4 steps of double round-off while still catching any leak of heat to the walls: a wall
+    taking heat at even 1% of the particle-particle flux would move the mean by millikelvin.
+    """
+    _, out = conduction_run
+    series = pd.read_csv(out / "post" / "mean_temperature.csv")
+    T = series["mean_temperature_C"].to_numpy()
+    assert np.abs(T - T[0]).max() < 1e-7
+    # The test is not vacuous: conduction did narrow the temperature spread meanwhile.
+    case = load_case(out / "case.toml")
+    snaps = read_series(out / "dem" / "dumps", json.loads((out / "manifest.json").read_text())["time_step"]["time_step"])
+    spread = np.nanstd(snaps["T"], axis=1)
+    assert spread[-1] < 0.98 * spread[0]
+    assert case.particles.initial_temperature_spread_C == 20.0
+
+
+@pytest.mark.timeout(400)
+def test_falling_mass_flow_is_positive_once_lifters_turn(conduction_run: tuple[dict, Path]) -> None:
+    summary, out = conduction_run
+    assert summary["falling_mass_flow_kg_s"] > 0
+    crossings = pd.read_csv(out / "post" / "crossings.csv")
+    assert (crossings["time"] >= 0).all() and len(crossings) == summary["falling_crossings"] + (
+        crossings["time"] < 0.6
+    ).sum()
+    # Independent bound: mass cannot fall faster than the whole charge once per half turn
+    # of a drum at 30 rpm (1 s per turn), i.e. 2 x total mass per second.
+    total = 500 * load_case(out / "case.toml").particles.mass
+    assert summary["falling_mass_flow_kg_s"] < 2 * total
+
+
+@pytest.mark.timeout(400)
+def test_post_recomputes_without_solver(conduction_run: tuple[dict, Path]) -> None:
+    summary, out = conduction_run
+    again = post_run(out)
+    for key in ("falling_mass_flow_kg_s", "mean_temperature_C", "particles_final"):
+        assert again[key] == summary[key]
+    assert again["mean_temperature_check_K"] < 1e-7
+    # Rerunning the same case reuses the finished DEM stage: no new LIGGGHTS command.
+    case = load_case(out / "case.toml")
+    n_commands = len(json.loads((out / "manifest.json").read_text())["commands"])
+    run_case(case, out)
+    assert len(json.loads((out / "manifest.json").read_text())["commands"]) == n_commands
+
+
+@pytest.mark.timeout(600)
+def test_interrupted_run_resumes(tmp_path: Path) -> None:
+    case = case_from_dict(tiny_case_dict(run__time=2.0, run__restart_interval=0.1))
+    out = tmp_path / "run"
+    with pytest.raises(SolverTimeoutError):
+        run_case(case, out, timeout=6)  # the whole run takes ~12 s: stopped part way
+    restarts = list((out / "dem" / "restart").glob("drum.*.restart"))
+    assert restarts, "no restart file was written before the interrupt"
+    summary = run_case(case, out, timeout=300)
+    dem = json.loads((out / "stages" / "dem.json").read_text())["result"]
+    assert dem["resumed_from_step"] is not None and dem["resumed_from_step"] > 0
+    assert summary["particles_final"] == 500
+    series = pd.read_csv(out / "post" / "mean_temperature.csv")
+    # The output grid is complete and unbroken across the resume.
+    output_step = dem["dump_every"] * dem["time_step"]
+    steps = np.round(series["time_s"].to_numpy() / output_step).astype(int)
+    assert steps[0] == 0 and steps[-1] == dem["steps"] // dem["dump_every"]
+    assert np.all(np.diff(steps) == 1)
+
+
+@pytest.mark.timeout(300)
+def test_lost_particles_are_a_failure(tmp_path: Path) -> None:
+    """Regression guard for `thermo_modify lost ignore`: particles leaving must stop the run."""
+    case = case_from_dict(tiny_case_dict(run__time=0.2, run__mass_flow_start=0.1))
+    rundir = RunDir(tmp_path / "run")
+    rundir.bind_case(case.canonical_json(), case.hash(), "")
+    geometry = build_geometry(case, rundir)
+    # Shoot every particle along the axis at 100 m/s: more than a radius per step, so they
+    # pass the end plane and leave the box.
+    with pytest.raises(LostParticlesError) as info:
+        run_dem(case, rundir, Runner(), geometry, extra_commands="velocity all set 0 0 100 units box",
+                timeout=120)
+    assert info.value.initial == 500 and info.value.final < 500
+    assert "left the domain" in str(info.value)
+
+
+@pytest.mark.slow
+@pytest.mark.timeout(900)
+@pytest.mark.parametrize("name", ["paper_model_one", "paper_model_two"])
+def test_paper_cases_start(name: str, tmp_path: Path) -> None:
+    """Both paper cases: geometry, insertion of every particle, set-up and their first steps."""
+    case = load_case(ROOT / "cases" / f"{name}.toml")
+    summary = run_case(case, tmp_path / name, steps=40, processes=2, timeout=800)
+    assert summary["particles_initial"] == summary["particles_final"] == case.particle_count

@@ -1,0 +1,28 @@
+"""Thermo series across an interrupted and resumed run (regression: an off-grid row survived)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from drumflow.dem.thermo import read_thermo
+
+HEADER = "Step v_sim_time Atoms KinEng c_ke_rot v_T_mean CPU \n"
+
+
+def _log(path: Path, steps: list[int], T: float) -> None:
+    rows = "".join(f"{s} {s * 1e-3} 500 0.1 0.01 {T} 1.0 \n" for s in steps)
+    path.write_text("LIGGGHTS (Version LIGGGHTS-PUBLIC 3.8.0)\n" + HEADER + rows + "Loop time of 1\n")
+
+
+def test_resumed_attempt_supersedes_the_interrupted_one(tmp_path: Path) -> None:
+    # First attempt: output every 10 steps, killed at step 42 (LIGGGHTS prints that step).
+    _log(tmp_path / "log.liggghts", [0, 10, 20, 30, 40, 42], 90.0)
+    # Resumed from the restart at step 30; ends with the repeated last step of `run 0`.
+    _log(tmp_path / "log.resume-30.liggghts", [30, 40, 50, 60, 60], 80.0)
+    table = read_thermo(tmp_path)
+    assert table["step"].tolist() == [0, 10, 20, 30, 40, 50, 60]
+    assert table["T_mean"].tolist() == [90.0, 90.0, 90.0, 80.0, 80.0, 80.0, 80.0]
+
+
+def test_no_logs_gives_empty_table(tmp_path: Path) -> None:
+    assert read_thermo(tmp_path).empty
