@@ -51,7 +51,9 @@ def check(case_file: Annotated[Path, typer.Argument(help="case file (TOML)")]) -
     try:
         case = _load(case_file)
         from drumflow.dem.timestep import choose_time_step
+        from drumflow.pipeline import refuse_unavailable
 
+        refuse_unavailable(case)
         choice = choose_time_step(case)
     except CaseError as exc:
         _fail(exc, 2)

@@ -31,10 +31,11 @@ from drumflow.report.plots import plot_crossings, plot_mean_temperature, plot_pa
 from drumflow.rundir import RunDir
 from drumflow.runner import LaunchProfile, Runner
 
-__all__ = ["run_case", "post_run"]
+__all__ = ["run_case", "post_run", "refuse_unavailable"]
 
 
-def _refuse_unavailable(case: Case) -> None:
+def refuse_unavailable(case: Case) -> None:
+    """Raise :class:`CaseError` for features the case asks for that this version lacks."""
     if case.air.model != "none":
         # Say so before any solver starts, rather than silently run without air.
         raise CaseError(
@@ -79,7 +80,7 @@ def run_case(
         data = case.model_dump(mode="json")
         data["run"]["processes"] = processes
         case = Case.model_validate(data)
-    _refuse_unavailable(case)
+    refuse_unavailable(case)
     rundir = RunDir(out)
     rundir.bind_case(case.canonical_json(), case.hash(), case_to_toml(case), force=force)
     runner = Runner(profile)

@@ -150,3 +150,17 @@ def test_cli_check_good_case() -> None:
     )
     assert out.returncode == 0, out.stderr
     assert "valid" in out.stdout
+
+
+def test_cli_check_refuses_air_model_not_built_yet(tmp_path: Path, smoke_dict: dict) -> None:
+    import tomli_w
+
+    smoke_dict["air"]["model"] = "cfd"
+    path = tmp_path / "cfd.toml"
+    path.write_text(tomli_w.dumps(smoke_dict))
+    out = subprocess.run(
+        [sys.executable, "-m", "drumflow.cli", "check", str(path)],
+        capture_output=True, text=True, timeout=120,
+    )
+    assert out.returncode == 2
+    assert "air.model = 'cfd'" in out.stderr and "allowed: 'none'" in out.stderr

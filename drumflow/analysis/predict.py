@@ -1,0 +1,474 @@
+"""Predict the plant's outlet temperatures at other operating conditions (the paper's purpose).
+
+Burgos-Florez et al., Processes 2019, 7, 673, Conclusions: with the dimensionless correlation
+``Nu = a Re^b Pr^c`` (Eq. 56), "heat-transfer coefficients and overall process operating
+characteristics can be predicted when process variables such as drum angular velocity, air
+velocity, material inlet-outlet temperatures, and the average particle diameter are changed
+inside the range of valid Reynolds numbers for the defined correlation". The paper does not say
+how each variable enters the exchanger model (Eqs. 42-48). :func:`predict_plant` makes the
+first-order assumptions below. They are listed in :data:`ASSUMPTIONS` and copied into every
+:class:`Prediction`.
+
+Reference state. One run of the case gives ``h`` (or a correlation from several runs gives
+``Nu``), the section's falling mass flow ``F_ref``, and with it the cooler's exchange area
+``A_he,ref`` (Eq. 46 with ``L / l``). A prediction changes some of the rotation speed ``N``,
+the air mass flow ``mdot_a``, the feed rate ``mdot_m`` and the particle diameter ``Dp``, and
+scales from that reference:
+
+1. Falling mass flow ``F = F_ref (mdot_m / mdot_m,ref) (N / N_ref)``. The flights empty their
+   load once per revolution (``~ N``), and the load is a fixed share of the hold-up. The hold-up
+   is ``mdot_m`` times the residence time, and the residence time is held at the case's value
+   (the paper: 30 min). A residence time that falls with ``N`` (Sullivan-type ``tau ~ 1/N``)
+   would cancel the ``N`` factor, so the rpm predictions are the least certain ones. The particle
+   diameter and the air flow do not change ``F``. The paper found almost the same falling mass
+   for 8 and 20 mm particles once scaled to equal ``dt`` and ``l`` (Section 4.2), and the air
+   drag on the curtain is ignored.
+2. Exchange area ``A_he = A_he,ref (F / F_ref) (Dp_ref / Dp)``. Eq. 41 gives the surface per
+   unit falling mass as ``6 / (rho Dp)``.
+3. Void fraction (Eq. 53). The solids volume of the section scales with the hold-up, so
+   ``V_m = V_m,ref (mdot_m / mdot_m,ref)``. A change of ``Dp`` at equal hold-up mass keeps
+   ``V_m``.
+4. Reynolds number (Eqs. 51-52). ``V_ai = mdot_a / (rho(T_ai) pi D^2 / 4)`` is proportional to
+   ``mdot_a``, ``v_max = V_ai / Vf`` and ``Re = v_max Dp / nu``.
+5. Air properties (``nu``, ``Pr``, ``k``) are taken at one temperature. With a reference
+   :class:`~drumflow.analysis.methodology.MethodologyResult`, that is the mean of its valid
+   steps' ``T_ma`` (Eq. 50), so the case's own point lies inside the range the correlation was
+   fitted on. Otherwise it is ``T_ai``. The per-step air warming (``T_ma - T_ai``, hundredths of
+   a kelvin in the paper) is not rescaled with the new conditions.
+6. ``h = Nu k / Dp`` (Eq. 49), with ``k`` the conductivity the correlation was fitted with
+   (``nusselt_conductivity``). A fixed ``h`` is used unchanged: it ignores how ``h`` depends on
+   ``Re`` and suits only small changes.
+7. The plant streams (Eqs. 42-48) are the case's ``plant`` and ``air`` sections with the new
+   feed rate and air flow. ``T_mo`` comes from
+   :func:`~drumflow.analysis.exchanger.solve_outlet_temperature`.
+
+Range. The correlation is empirical. The paper's correlation is valid for 3073 < Re < 7686
+(Figure 9, :data:`PAPER_REYNOLDS_RANGE`), and a fitted :class:`NusseltCorrelation` carries its
+own range. A prediction whose ``Re`` leaves that range gets a :class:`CorrelationRangeWarning`
+in ``Prediction.range_warnings`` and a message in ``Prediction.warnings``. So does a ``Pr`` more
+than 1 % outside the fitted ``Pr`` range. The function itself emits no Python warning, so that
+a batch of predictions can be collected and reported.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass, field
+from typing import Any, Literal
+
+from drumflow.analysis import air_properties as air
+from drumflow.analysis._validate import AnalysisInputError, check_positive
+from drumflow.analysis.correlation import CorrelationRangeWarning, NusseltCorrelation
+from drumflow.analysis.dimensionless import drum_volume, mean_air_inlet_velocity, particle_volume
+from drumflow.analysis.exchanger import ExchangerResult, solve_outlet_temperature
+from drumflow.analysis.heat_transfer import falling_particle_area
+from drumflow.analysis.methodology import (
+    MethodologyResult,
+    _json_safe,
+    exchanger_to_dict,
+    plant_streams,
+)
+from drumflow.case import Case
+
+__all__ = [
+    "ASSUMPTIONS",
+    "PAPER_CORRELATION",
+    "PAPER_REYNOLDS_RANGE",
+    "CorrelationRangeWarning",
+    "OperatingPoint",
+    "Prediction",
+    "predict_plant",
+]
+
+PAPER_REYNOLDS_RANGE: tuple[float, float] = (3073.0, 7686.0)
+"""Validity range of the paper's correlation, Eq. 58 and Figure 9."""
+
+PAPER_CORRELATION: tuple[float, float, float] = (0.0531283, 0.523707, 1.00824)
+"""``(a, b, c)`` of the paper's Eq. 58 (fitted with the particle conductivity in Nu)."""
+
+# A fit on per-step data spans only the Pr of the per-step air temperatures, a few hundredths
+# of a kelvin wide, so a strict Pr test would flag every prediction. Air Pr changes by about 1 %
+# over 25 K (Incropera Table A.4, 300-350 K), so a 1 % excess means a really different air
+# temperature.
+_PRANDTL_RTOL = 0.01
+
+ASSUMPTIONS: tuple[str, ...] = (
+    "Falling mass flow F scales as (feed rate / reference) x (rpm / reference): the flights empty "
+    "their load once per revolution, and the load follows the hold-up at the case's residence "
+    "time. A residence time falling as 1/rpm would cancel the rpm factor, so rpm predictions are "
+    "the least certain ones. Dp and the air flow leave F unchanged.",
+    "Exchange area A_he scales as (F / F_ref) x (Dp_ref / Dp) (Eq. 41: surface per mass 6/(rho Dp)).",
+    "Solids volume of the section scales with the feed rate (hold-up at fixed residence time); "
+    "Dp at equal hold-up mass keeps it; the void fraction follows (Eq. 53).",
+    "Air inlet velocity is proportional to the air mass flow (density at T_ai, full drum "
+    "cross-section); v_max = V_ai / Vf; Re = v_max Dp / nu (Eqs. 51-52).",
+    "Air properties at one temperature: the reference run's mean T_ma, else T_ai; the per-step "
+    "air warming is not rescaled.",
+    "h = Nu k / Dp with the conductivity the correlation was fitted with; a fixed h is used "
+    "unchanged (valid for small changes only).",
+    "Plant streams: the case's plant and air sections with the new feed rate and air flow; T_mo "
+    "from the counter-current exchanger model (Eq. 48).",
+)
+
+
+@dataclass(frozen=True)
+class OperatingPoint:
+    """The variables a prediction can change.
+
+    Attributes
+    ----------
+    rpm
+        Drum rotation speed (1/min).
+    air_mass_flow_kg_s
+        Air mass flow (kg/s).
+    feed_rate_kg_s
+        Material mass flow (kg/s).
+    particle_diameter_m
+        Particle diameter (m).
+    """
+
+    rpm: float
+    air_mass_flow_kg_s: float
+    feed_rate_kg_s: float
+    particle_diameter_m: float
+
+
+@dataclass(frozen=True)
+class Prediction:
+    """Outlet temperatures of the plant at new operating conditions, with the reference point.
+
+    Attributes
+    ----------
+    h_source
+        ``"correlation"`` or ``"fixed"``.
+    reference, conditions
+        The case's operating point and the predicted one.
+    air_property_temperature_c
+        Temperature at which ``nu``, ``Pr`` and (air) ``k`` were taken (deg C).
+    conductivity_w_mk
+        ``k`` in ``Nu = h Dp / k`` (W/(m K)).
+    void_fraction, reference_void_fraction
+        Eq. 53 at the new and the reference point.
+    air_inlet_velocity_m_s, max_air_velocity_m_s
+        ``V_ai`` and ``v_max`` at the new point (m/s).
+    reynolds, reference_reynolds
+        Eq. 51 at the new and the reference point.
+    prandtl
+        Air Prandtl number.
+    nusselt
+        ``h Dp / k`` at the new point.
+    h_w_m2k, reference_h_w_m2k
+        Heat-transfer coefficient at the new and the reference point (W/(m2 K)); equal for a
+        fixed ``h``.
+    measured_h_w_m2k
+        The reference run's time-averaged ``h`` when a reference result was given, else None.
+    falling_mass_flow_kg_s, reference_falling_mass_flow_kg_s
+        Falling mass flow of the simulated section (kg/s).
+    exchanger_area_m2, reference_exchanger_area_m2
+        ``A_he`` of the cooler (m2).
+    exchanger, reference_exchanger
+        The exchanger model at the new and at the reference point (``T_mo``, ``T_ao``, ``Q_m``...).
+    range_warnings
+        A :class:`CorrelationRangeWarning` for each range the prediction leaves.
+    warnings
+        Human-readable remarks, including every range warning.
+    assumptions
+        The scaling assumptions (:data:`ASSUMPTIONS`).
+    """
+
+    h_source: Literal["correlation", "fixed"]
+    reference: OperatingPoint
+    conditions: OperatingPoint
+    air_property_temperature_c: float
+    conductivity_w_mk: float
+    void_fraction: float
+    reference_void_fraction: float
+    air_inlet_velocity_m_s: float
+    max_air_velocity_m_s: float
+    reynolds: float
+    reference_reynolds: float
+    prandtl: float
+    nusselt: float
+    h_w_m2k: float
+    reference_h_w_m2k: float
+    measured_h_w_m2k: float | None
+    falling_mass_flow_kg_s: float
+    reference_falling_mass_flow_kg_s: float
+    exchanger_area_m2: float
+    reference_exchanger_area_m2: float
+    exchanger: ExchangerResult
+    reference_exchanger: ExchangerResult
+    range_warnings: list[CorrelationRangeWarning] = field(default_factory=list)
+    warnings: list[str] = field(default_factory=list)
+    assumptions: tuple[str, ...] = ASSUMPTIONS
+
+    @property
+    def material_outlet_temperature_c(self) -> float:
+        """Predicted ``T_mo`` (deg C)."""
+        return self.exchanger.material_outlet_temperature_c
+
+    @property
+    def air_outlet_temperature_c(self) -> float:
+        """Predicted ``T_ao`` (deg C)."""
+        return self.exchanger.air_outlet_temperature_c
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready dict (NaN as ``null``; warnings as strings)."""
+        data = {
+            "h_source": self.h_source,
+            "reference": asdict(self.reference),
+            "conditions": asdict(self.conditions),
+            "air_property_temperature_C": self.air_property_temperature_c,
+            "conductivity_W_mK": self.conductivity_w_mk,
+            "void_fraction": self.void_fraction,
+            "reference_void_fraction": self.reference_void_fraction,
+            "air_inlet_velocity_m_s": self.air_inlet_velocity_m_s,
+            "max_air_velocity_m_s": self.max_air_velocity_m_s,
+            "reynolds": self.reynolds,
+            "reference_reynolds": self.reference_reynolds,
+            "prandtl": self.prandtl,
+            "nusselt": self.nusselt,
+            "h_W_m2K": self.h_w_m2k,
+            "reference_h_W_m2K": self.reference_h_w_m2k,
+            "measured_h_W_m2K": self.measured_h_w_m2k,
+            "falling_mass_flow_kg_s": self.falling_mass_flow_kg_s,
+            "reference_falling_mass_flow_kg_s": self.reference_falling_mass_flow_kg_s,
+            "area_he_m2": self.exchanger_area_m2,
+            "reference_area_he_m2": self.reference_exchanger_area_m2,
+            "exchanger": exchanger_to_dict(self.exchanger),
+            "reference_exchanger": exchanger_to_dict(self.reference_exchanger),
+            "warnings": list(self.warnings),
+            "assumptions": list(self.assumptions),
+        }
+        return _json_safe(data)
+
+
+def _reynolds(
+    case: Case, point: OperatingPoint, solids_volume_m3: float, property_t_c: float
+) -> tuple[float, float, float, float]:
+    """``(Re, Vf, V_ai, v_max)`` at an operating point (Eqs. 51-54, assumptions 3-5)."""
+    v_d = drum_volume(case.drum.diameter, case.drum.length)
+    if solids_volume_m3 >= v_d:
+        raise AnalysisInputError(
+            "feed_rate",
+            point.feed_rate_kg_s,
+            f"a feed rate whose hold-up fits the drum section (solids {solids_volume_m3:.4g} m3 "
+            f"in {v_d:.4g} m3 of drum)",
+        )
+    vf = (v_d - solids_volume_m3) / v_d
+    v_ai = mean_air_inlet_velocity(
+        air_mass_flow_kg_s=point.air_mass_flow_kg_s,
+        drum_diameter_m=case.drum.diameter,
+        air_inlet_temperature_c=case.air.inlet_temperature_C,
+    )
+    v_max = v_ai / vf
+    nu = float(air.kinematic_viscosity(property_t_c, name="air property temperature"))
+    return v_max * point.particle_diameter_m / nu, vf, v_ai, v_max
+
+
+def predict_plant(
+    correlation_or_h: NusseltCorrelation | float,
+    case: Case,
+    *,
+    rpm: float | None = None,
+    air_mass_flow: float | None = None,
+    feed_rate: float | None = None,
+    particle_diameter: float | None = None,
+    reference: MethodologyResult | None = None,
+    falling_mass_flow_kg_s: float | None = None,
+    nusselt_conductivity: Literal["air", "particle"] = "air",
+) -> Prediction:
+    """Predict the plant outlet temperatures when rpm, air flow, feed rate or Dp change.
+
+    See the module notes for the scaling assumptions; they are also in
+    ``Prediction.assumptions``.
+
+    Parameters
+    ----------
+    correlation_or_h
+        A fitted :class:`~drumflow.analysis.correlation.NusseltCorrelation` (``h`` follows the
+        new ``Re``), or a fixed heat-transfer coefficient in W/(m2 K) (used unchanged).
+    case
+        The case the reference was obtained with. Its drum, particles, air and plant sections
+        give the reference operating point and the plant streams.
+    rpm, air_mass_flow, feed_rate, particle_diameter
+        New rotation speed (1/min), air mass flow (kg/s), material feed rate (kg/s) and particle
+        diameter (m). None keeps the case's value.
+    reference
+        The methodology result of a run of ``case``. It gives the reference falling mass flow,
+        ``A_he`` and the air property temperature. Give this or ``falling_mass_flow_kg_s``.
+    falling_mass_flow_kg_s
+        The section's falling mass flow at the case's conditions (kg/s, e.g.
+        ``summary.json``'s ``falling_mass_flow_kg_s``), when no reference result is at hand.
+    nusselt_conductivity
+        Conductivity in ``Nu = h Dp / k``. It must be the one the correlation was fitted with:
+        ``"air"`` (air at the property temperature) or ``"particle"``
+        (``particles.conductivity``, as in the paper's Eq. 58).
+
+    Returns
+    -------
+    Prediction
+        The predicted and the reference exchanger results, ``Re``, ``h``, ``A_he``, and the
+        warnings.
+
+    Raises
+    ------
+    AnalysisInputError
+        If a value is not finite and positive, neither or both of ``reference`` and
+        ``falling_mass_flow_kg_s`` are given, the new rpm makes the drum centrifuge
+        (Froude >= 1), the hold-up no longer fits the section, or the streams are not a cooler.
+    """
+    if nusselt_conductivity not in ("air", "particle"):
+        raise AnalysisInputError("nusselt_conductivity", nusselt_conductivity, "'air' or 'particle'")
+    if (reference is None) == (falling_mass_flow_kg_s is None):
+        raise AnalysisInputError(
+            "reference or falling_mass_flow_kg_s",
+            "both given" if reference is not None else "none given",
+            "exactly one: the reference run's methodology result or its falling mass flow",
+        )
+    if isinstance(correlation_or_h, NusseltCorrelation):
+        correlation: NusseltCorrelation | None = correlation_or_h
+        fixed_h = math.nan
+    elif isinstance(correlation_or_h, (int, float)) and not isinstance(correlation_or_h, bool):
+        correlation = None
+        fixed_h = check_positive("correlation_or_h", correlation_or_h)
+    else:
+        raise AnalysisInputError(
+            "correlation_or_h",
+            type(correlation_or_h).__name__,
+            "a NusseltCorrelation or a heat-transfer coefficient in W/(m2 K)",
+        )
+
+    ref = OperatingPoint(
+        rpm=float(case.drum.rpm),
+        air_mass_flow_kg_s=float(case.air.mass_flow),
+        feed_rate_kg_s=float(case.plant.material_mass_flow),
+        particle_diameter_m=float(case.particles.diameter),
+    )
+    new = OperatingPoint(
+        rpm=ref.rpm if rpm is None else check_positive("rpm", rpm),
+        air_mass_flow_kg_s=ref.air_mass_flow_kg_s
+        if air_mass_flow is None
+        else check_positive("air_mass_flow", air_mass_flow),
+        feed_rate_kg_s=ref.feed_rate_kg_s
+        if feed_rate is None
+        else check_positive("feed_rate", feed_rate),
+        particle_diameter_m=ref.particle_diameter_m
+        if particle_diameter is None
+        else check_positive("particle_diameter", particle_diameter),
+    )
+    check_positive("air.mass_flow of the case", ref.air_mass_flow_kg_s)
+    omega = new.rpm * 2.0 * math.pi / 60.0
+    froude = omega**2 * case.drum.radius / 9.81
+    if froude >= 1.0:
+        limit = 60.0 / (2.0 * math.pi) * math.sqrt(9.81 / case.drum.radius)
+        raise AnalysisInputError(
+            "rpm", new.rpm, f"a speed below {limit:.3g} rpm (Froude {froude:.3g} >= 1: centrifuging)"
+        )
+
+    notes: list[str] = []
+    range_warnings: list[CorrelationRangeWarning] = []
+    if reference is not None:
+        f_ref = reference.falling_mass_flow_kg_s
+        a_ref = reference.exchanger_area_m2
+        valid = reference.steps["valid"].to_numpy(dtype=bool)
+        property_t = float(reference.steps["mean_air_temperature_C"].to_numpy()[valid].mean())
+        measured_h: float | None = reference.h_mean_w_m2k
+        if reference.case.hash() != case.hash():
+            notes.append(
+                f"the reference run's case ({reference.case.name}) differs from the case given "
+                f"({case.name}); the reference falling mass flow and area are used as they are"
+            )
+    else:
+        f_ref = check_positive("falling_mass_flow_kg_s", falling_mass_flow_kg_s)
+        # Eq. 46 with m_mf = F * dt is independent of dt: evaluate it for dt = 1 s.
+        one_second = 1.0
+        a_ref = float(falling_particle_area(f_ref * one_second, ref.particle_diameter_m,
+                                           case.particles.density))
+        a_ref *= case.plant.length / case.drum.length / one_second
+        property_t = float(case.air.inlet_temperature_C)
+        measured_h = None
+
+    # Assumptions 1-3.
+    fall_ratio = (new.feed_rate_kg_s / ref.feed_rate_kg_s) * (new.rpm / ref.rpm)
+    f_new = f_ref * fall_ratio
+    a_new = a_ref * fall_ratio * (ref.particle_diameter_m / new.particle_diameter_m)
+    v_m_ref = particle_volume(case.particle_count, ref.particle_diameter_m)
+    v_m_new = v_m_ref * (new.feed_rate_kg_s / ref.feed_rate_kg_s)
+
+    # Assumptions 4-6.
+    re_ref, vf_ref, _, _ = _reynolds(case, ref, v_m_ref, property_t)
+    re_new, vf_new, v_ai, v_max = _reynolds(case, new, v_m_new, property_t)
+    pr = float(air.prandtl(property_t, name="air property temperature"))
+    if nusselt_conductivity == "particle":
+        k = float(case.particles.conductivity)
+    else:
+        k = float(air.thermal_conductivity(property_t, name="air property temperature"))
+
+    changed = new != ref
+    if correlation is not None:
+        nu_new = float(correlation.predict(re_new, pr, warn=False))
+        nu_ref = float(correlation.predict(re_ref, pr, warn=False))
+        h_new = nu_new * k / new.particle_diameter_m
+        h_ref = nu_ref * k / ref.particle_diameter_m
+        lo, hi = correlation.reynolds_range
+        if not lo <= re_new <= hi:
+            msg = (
+                f"Re = {re_new:.5g} is outside the correlation's range [{lo:.5g}, {hi:.5g}]: "
+                "the predicted h is an extrapolation"
+            )
+            range_warnings.append(CorrelationRangeWarning(msg))
+            notes.append(msg)
+        p_lo, p_hi = correlation.prandtl_range
+        if pr < p_lo * (1.0 - _PRANDTL_RTOL) or pr > p_hi * (1.0 + _PRANDTL_RTOL):
+            msg = (
+                f"Pr = {pr:.4g} is more than {_PRANDTL_RTOL:.0%} outside the correlation's range "
+                f"[{p_lo:.4g}, {p_hi:.4g}]"
+            )
+            range_warnings.append(CorrelationRangeWarning(msg))
+            notes.append(msg)
+    else:
+        h_new = h_ref = fixed_h
+        nu_new = h_new * new.particle_diameter_m / k
+        if changed:
+            notes.append(
+                f"h held at {fixed_h:.4g} W/(m2 K): the prediction ignores how h changes with Re "
+                f"(here {re_ref:.4g} -> {re_new:.4g}); use a fitted correlation for larger changes"
+            )
+
+    # Assumption 7.
+    exchanger = solve_outlet_temperature(
+        h_w_m2k=h_new,
+        area_m2=a_new,
+        **plant_streams(case, feed_rate_kg_s=new.feed_rate_kg_s,
+                        air_mass_flow_kg_s=new.air_mass_flow_kg_s),
+    )
+    reference_exchanger = solve_outlet_temperature(
+        h_w_m2k=h_ref, area_m2=a_ref, **plant_streams(case)
+    )
+    return Prediction(
+        h_source="correlation" if correlation is not None else "fixed",
+        reference=ref,
+        conditions=new,
+        air_property_temperature_c=property_t,
+        conductivity_w_mk=k,
+        void_fraction=vf_new,
+        reference_void_fraction=vf_ref,
+        air_inlet_velocity_m_s=v_ai,
+        max_air_velocity_m_s=v_max,
+        reynolds=re_new,
+        reference_reynolds=re_ref,
+        prandtl=pr,
+        nusselt=nu_new,
+        h_w_m2k=h_new,
+        reference_h_w_m2k=h_ref,
+        measured_h_w_m2k=measured_h,
+        falling_mass_flow_kg_s=f_new,
+        reference_falling_mass_flow_kg_s=f_ref,
+        exchanger_area_m2=a_new,
+        reference_exchanger_area_m2=a_ref,
+        exchanger=exchanger,
+        reference_exchanger=reference_exchanger,
+        range_warnings=range_warnings,
+        warnings=notes,
+    )

@@ -1,0 +1,684 @@
+"""One self-contained HTML page for a run or a sweep of runs (the paper's Tables 6-8, Figures 4, 6-9).
+
+The page has no external references. Every picture is embedded as a base64 PNG ``data:`` URI,
+the style sheet is inline, and there is no script, so the file can be mailed, archived or opened
+offline. It holds:
+
+* per run: the case (table), the observables of ``summary.json``, the mean temperature curve
+  (Figures 7-8), the per-step ``h``, the crossing scatter (Figure 4, ``post/crossings.png``), an
+  off-screen PyVista picture of the last snapshot coloured by temperature (Figure 6), the
+  geometry cross-section, and the manifest (pretty JSON in a ``<details>`` block);
+* across runs: Table 6 (heat-transfer variables), Table 7 (exchanger model against the plant),
+  Table 8 (correlation and ANOVA, when the data allow a fit, otherwise the reason), and
+  Nu against Re with the fitted curve (Figure 9).
+
+Nothing stops the page from being written. A run without air (no ``h``), a missing file or a
+failed render gives a note in its place. Only a run directory that does not exist is an error.
+"""
+
+from __future__ import annotations
+
+import base64
+import io
+import json
+import math
+import tempfile
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from drumflow.analysis._validate import AnalysisInputError
+from drumflow.analysis.correlation import NusseltCorrelation
+from drumflow.analysis.methodology import (
+    CASE_FILE,
+    MEAN_TEMPERATURE_FILE,
+    FallingMassMode,
+    MethodologyResult,
+    NusseltConductivity,
+    analyse_run,
+    fit_runs,
+)
+from drumflow.case import Case, load_case
+from drumflow.errors import DrumflowError, RunDirectoryError
+
+__all__ = ["write_report"]
+
+
+@dataclass
+class _Table:
+    caption: str
+    header: list[str]
+    rows: list[list[str]]
+    note: str = ""
+
+
+@dataclass
+class _Figure:
+    title: str
+    caption: str = ""
+    uri: str | None = None
+    note: str | None = None
+
+
+@dataclass
+class _RunView:
+    name: str
+    path: str
+    anchor: str
+    notes: list[str] = field(default_factory=list)
+    tables: list[_Table] = field(default_factory=list)
+    figures: list[_Figure] = field(default_factory=list)
+    manifest_json: str | None = None
+
+
+# ------------------------------------------------------------------------------ helpers
+
+
+def _fmt(value: Any, digits: int = 5) -> str:
+    if value is None:
+        return "–"
+    if isinstance(value, (bool, np.bool_)):
+        return "yes" if value else "no"
+    if isinstance(value, (int, np.integer)):
+        return f"{int(value):,}"
+    if isinstance(value, (float, np.floating)):
+        v = float(value)
+        if not math.isfinite(v):
+            return "–"
+        return f"{v:.{digits}g}"
+    if isinstance(value, (list, tuple)):
+        return ", ".join(_fmt(v, digits) for v in value)
+    return str(value)
+
+
+def _png_uri(data: bytes) -> str:
+    return "data:image/png;base64," + base64.b64encode(data).decode("ascii")
+
+
+def _file_uri(path: Path) -> str | None:
+    try:
+        data = path.read_bytes()
+    except OSError:
+        return None
+    # Only PNG files are embedded: the page promises PNG data URIs and nothing else.
+    return _png_uri(data) if data.startswith(b"\x89PNG\r\n\x1a\n") else None
+
+
+def _plt():  # type: ignore[no-untyped-def]
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def _fig_uri(draw: Callable[[Any], None], size: tuple[float, float] = (6.4, 3.8)) -> str:
+    plt = _plt()
+    fig, ax = plt.subplots(figsize=size, dpi=110)
+    try:
+        draw(ax)
+        fig.tight_layout()
+        buf = io.BytesIO()
+        # No "Software" text chunk: the page should carry no outside references, even encoded.
+        fig.savefig(buf, format="png", metadata={"Software": None})
+    finally:
+        plt.close(fig)
+    return _png_uri(buf.getvalue())
+
+
+def _read_json(path: Path) -> dict[str, Any] | None:
+    try:
+        data = json.loads(path.read_text())
+    except (OSError, ValueError):
+        return None
+    return data if isinstance(data, dict) else None
+
+
+def _anchor(i: int, name: str) -> str:
+    safe = "".join(c if c.isalnum() or c in "-_" else "-" for c in name)
+    return f"run-{i}-{safe}"
+
+
+# ---------------------------------------------------------------------------- run parts
+
+
+def _case_table(case: Case) -> _Table:
+    rows: list[list[str]] = []
+    for section, values in case.model_dump(mode="json").items():
+        if isinstance(values, dict):
+            for key, val in values.items():
+                if isinstance(val, dict):
+                    for sub, v in val.items():
+                        rows.append([f"{section}.{key}.{sub}", _fmt(v)])
+                else:
+                    rows.append([f"{section}.{key}", _fmt(val)])
+        else:
+            rows.append([section, _fmt(values)])
+    rows.append(["(derived) particle count", _fmt(case.particle_count)])
+    rows.append(["(derived) particle mass total, kg", _fmt(case.particle_mass_total)])
+    rows.append(["(derived) Froude number", _fmt(case.drum.froude)])
+    return _Table("Case", ["field", "value"], rows)
+
+
+_SUMMARY_LABELS = {
+    "particles_initial": "particles at start",
+    "particles_final": "particles at end",
+    "particles_escaped_through_walls": "escaped through walls",
+    "simulated_time_s": "simulated time, s",
+    "mean_temperature_initial_C": "mean temperature at start, °C",
+    "mean_temperature_C": "mean temperature at end, °C",
+    "falling_mass_flow_kg_s": "falling mass flow (Eq. 57), kg/s",
+    "curtain_mass_flow_kg_s": "of which curtain, kg/s",
+    "falling_crossings": "crossings counted",
+    "wall_time_s": "wall time, s",
+    "particle_steps_per_s": "particle-steps per second",
+}
+
+
+def _summary_table(summary: dict[str, Any]) -> _Table:
+    rows = [[label, _fmt(summary[key])] for key, label in _SUMMARY_LABELS.items() if key in summary]
+    # Any other scalar the run recorded, so nothing in summary.json is hidden.
+    for key, val in summary.items():
+        if key not in _SUMMARY_LABELS and isinstance(val, (int, float, str, bool)):
+            rows.append([key, _fmt(val)])
+    return _Table("Observables (summary.json)", ["quantity", "value"], rows)
+
+
+def _mean_temperature_figure(root: Path) -> _Figure:
+    fig = _Figure("Mean particle temperature (Figures 7 and 8)")
+    png = _file_uri(root / "post" / "mean_temperature.png")
+    if png is not None:
+        fig.uri = png
+        return fig
+    csv = root / MEAN_TEMPERATURE_FILE
+    try:
+        table = pd.read_csv(csv)
+        t = table["time_s"].to_numpy(dtype=float)
+        temp = table["mean_temperature_C"].to_numpy(dtype=float)
+    except (OSError, ValueError, KeyError) as exc:
+        fig.note = f"no mean temperature: {csv} could not be read ({exc})"
+        return fig
+
+    def draw(ax: Any) -> None:
+        ax.plot(t, temp, color="tab:red", lw=1.6)
+        ax.set_xlabel("time (s)")
+        ax.set_ylabel("mean particle temperature (°C)")
+        ax.grid(alpha=0.3)
+
+    fig.uri = _fig_uri(draw)
+    fig.caption = f"from {MEAN_TEMPERATURE_FILE} (no mean_temperature.png in the run)"
+    return fig
+
+
+def _h_figure(result: MethodologyResult) -> _Figure:
+    s = result.steps
+
+    def draw(ax: Any) -> None:
+        ok = s["valid"].to_numpy(dtype=bool)
+        ax.plot(s["time_s"][ok], s["h_W_m2K"][ok], ".", ms=3, color="tab:blue", label="per step")
+        ax.axhline(result.h_mean_w_m2k, color="tab:red", lw=1.4,
+                   label=f"time average {result.h_mean_w_m2k:.4g} W/(m² K)")
+        ax.set_xlabel("time (s)")
+        ax.set_ylabel("h (W/(m² K))")
+        # Plain tick labels: an offset such as "1e-5+6e1" hides the value being read off.
+        ax.ticklabel_format(axis="y", useOffset=False, style="plain")
+        h_ok = s["h_W_m2K"].to_numpy(dtype=float)[ok]
+        if h_ok.size and np.ptp(h_ok) < 0.01 * abs(result.h_mean_w_m2k):
+            # A nearly constant h would be drawn as noise magnified to the full axis height.
+            pad = 0.05 * abs(result.h_mean_w_m2k)
+            ax.set_ylim(result.h_mean_w_m2k - pad, result.h_mean_w_m2k + pad)
+        ax.legend(fontsize=8)
+        ax.grid(alpha=0.3)
+
+    masked = result.masked
+    caption = f"{result.n_valid} valid of {result.n_steps} steps"
+    if masked:
+        caption += "; masked: " + ", ".join(f"{v} {k.replace('_', ' ')}" for k, v in masked.items())
+    return _Figure("Heat-transfer coefficient per step (Eqs. 34-41)", caption, _fig_uri(draw))
+
+
+def _particles_figure(root: Path, case: Case, manifest: dict[str, Any] | None,
+                      render_3d: bool, timeout_s: float) -> _Figure:
+    fig = _Figure("Particles coloured by temperature, last snapshot (Figure 6)")
+    if not render_3d:
+        fig.note = "3-D rendering was switched off for this report"
+        return fig
+    from drumflow.dem.dumps import dump_files, read_dump
+    from drumflow.report.render import RenderError, render_particles_isolated
+
+    files = dump_files(root / "dem" / "dumps", "snap")
+    if not files:
+        fig.note = f"no particle snapshot in {root / 'dem' / 'dumps'} (snap.*.txt)"
+        return fig
+    try:
+        snap = read_dump(files[-1])
+        cols = snap.columns
+        missing = [c for c in ("x", "y", "z", "T") if c not in cols]
+        if missing:
+            raise RenderError(f"{files[-1]} lacks column(s) {', '.join(missing)}")
+        ts = ((manifest or {}).get("time_step") or {}).get("time_step")
+        when = f"t = {snap.step * float(ts):.3g} s" if ts else f"step {snap.step}"
+        with tempfile.TemporaryDirectory(prefix="drumflow-report-") as tmp:
+            png = render_particles_isolated(
+                cols["x"], cols["y"], cols["z"], cols["T"], Path(tmp) / "particles.png",
+                case.drum.radius, case.drum.length,
+                particle_diameter=case.particles.diameter,
+                title=f"{case.name}, {when}",
+                timeout_s=timeout_s,
+            )
+            fig.uri = _file_uri(png)
+        fig.caption = f"{len(snap):,} particles from {files[-1].name}, {when} (PyVista, off-screen)"
+        if fig.uri is None:
+            fig.note = "the renderer wrote no PNG picture"
+    except (DrumflowError, OSError, ValueError) as exc:
+        fig.note = f"the 3-D picture could not be rendered: {exc}"
+    return fig
+
+
+def _run_view(i: int, root: Path, result: MethodologyResult | None, why_not: str | None,
+              render_3d: bool, timeout_s: float) -> _RunView:
+    case: Case | None = result.case if result is not None else None
+    notes: list[str] = []
+    if case is None:
+        try:
+            case = load_case(root / CASE_FILE)
+        except DrumflowError as exc:
+            notes.append(f"case not available: {exc}")
+    name = case.name if case is not None else root.name
+    view = _RunView(name=name, path=str(root), anchor=_anchor(i, name), notes=notes)
+    if why_not:
+        view.notes.append(f"heat-transfer methodology not applied: {why_not}")
+    if result is not None:
+        view.notes.extend(result.warnings)
+    if case is not None:
+        view.tables.append(_case_table(case))
+    summary = _read_json(root / "summary.json")
+    if summary is not None:
+        view.tables.append(_summary_table(summary))
+    else:
+        view.notes.append(f"no summary: {root / 'summary.json'} is missing or not JSON")
+    manifest = _read_json(root / "manifest.json")
+    view.manifest_json = json.dumps(manifest, indent=2, sort_keys=False) if manifest else None
+
+    view.figures.append(_mean_temperature_figure(root))
+    if result is not None:
+        view.figures.append(_h_figure(result))
+    crossings = _Figure("Particles crossing the axis plane downwards (Figure 4)",
+                        uri=_file_uri(root / "post" / "crossings.png"))
+    if crossings.uri is None:
+        crossings.note = f"no crossing plot: {root / 'post' / 'crossings.png'} is missing"
+    view.figures.append(crossings)
+    if case is not None:
+        view.figures.append(_particles_figure(root, case, manifest, render_3d, timeout_s))
+    section = _file_uri(root / "post" / "particles_final.png")
+    if section is not None:
+        view.figures.append(_Figure("Cross-section at the end of the run", uri=section))
+    geometry = _file_uri(root / "geometry" / "cross_section.png")
+    if geometry is not None:
+        view.figures.append(_Figure("Drum and lifter geometry", uri=geometry))
+    return view
+
+
+# --------------------------------------------------------------------------- sweep parts
+
+
+def _table6(names: list[str], results: list[MethodologyResult | None]) -> _Table:
+    rows_def: list[tuple[str, Callable[[MethodologyResult], Any]]] = [
+        ("Particle diameter Dp (mm)", lambda r: r.case.particles.diameter * 1e3),
+        ("Time step dt (s)", lambda r: r.dt_s),
+        ("Air mass m_a (kg)", lambda r: r.air_mass_per_step_kg),
+        ("Material falling mass m_mf (kg)", lambda r: r.falling_mass_per_step_kg),
+        ("Falling mass flow (kg/s)", lambda r: r.falling_mass_flow_kg_s),
+        ("Area of heat exchange A_fp (m²)", lambda r: r.falling_area_m2),
+        ("Average heat transfer coefficient h (W/(m² K))", lambda r: r.h_mean_w_m2k),
+        ("Valid steps / steps", lambda r: f"{r.n_valid:,} / {r.n_steps:,}"),
+    ]
+    rows = [[label] + [_fmt(get(r)) if r is not None else "–" for r in results]
+            for label, get in rows_def]
+    return _Table("Table 6. Heat transfer variables during one time step", ["Model"] + names, rows)
+
+
+def _table7(names: list[str], results: list[MethodologyResult | None]) -> _Table:
+    columns: list[tuple[str, Any, Any]] = []  # (header, exchanger result, methodology result)
+    for name, r in zip(names, results, strict=True):
+        if r is None:
+            continue
+        columns.append((name, r.exchanger, r))
+        if r.plant_exchanger is not None:
+            columns.append((f"{name}: plant at its T_mo", r.plant_exchanger, r))
+    spec: list[tuple[str, Callable[[Any], Any]]] = [
+        ("Particle diameter Dp (mm)", lambda c: c[2].case.particles.diameter * 1e3),
+        ("Thermodynamic model", lambda c: ""),
+        ("Material outlet temperature T_mo (°C)", lambda c: c[1].material_outlet_temperature_c),
+        ("Thermal power Q_m (kW)", lambda c: c[1].heat_removed_w / 1e3),
+        ("Air outlet temperature T_ao (°C)", lambda c: c[1].air_outlet_temperature_c),
+        ("Counter-current heat exchanger model", lambda c: ""),
+        ("Material inlet temperature T_mi (°C)", lambda c: c[1].material_inlet_temperature_c),
+        ("Air inlet temperature T_ai (°C)", lambda c: c[1].air_inlet_temperature_c),
+        ("LMTD_he (°C)", lambda c: c[1].lmtd_c),
+        ("Heat transfer coefficient h (W/(m² K))", lambda c: c[1].h_w_m2k),
+        ("Exchanged heat Q_he (kW)", lambda c: c[1].heat_exchanged_w / 1e3),
+        ("Total area of heat exchange A_he (m²)", lambda c: c[1].area_m2),
+    ]
+    rows = [[label] + [_fmt(get(c)) for c in columns] for label, get in spec]
+    note = (
+        "Model columns: A_he from the simulated section (Eq. 46 with L/l), T_mo solved from "
+        "Q_he = Q_m (Eq. 48). Plant columns (when the case gives plant.material_outlet_temperature_C): "
+        "the area the plant needs to reach that outlet temperature with the run's h."
+    )
+    return _Table("Table 7. Thermodynamic and counter-current exchanger models",
+                  ["Property"] + [c[0] for c in columns], rows, note)
+
+
+def _table8(corr: NusseltCorrelation) -> list[_Table]:
+    coef = _Table(
+        "Table 8a. Correlation Nu = a Re^b Pr^c (Eq. 56, Levenberg-Marquardt)",
+        ["Parameter", "Estimate", "Std. error", "95 % confidence interval"],
+        [
+            ["a", _fmt(corr.a, 6), _fmt(corr.se_a, 3), _fmt(corr.ci_a, 5)],
+            ["b", _fmt(corr.b, 6), _fmt(corr.se_b, 3), _fmt(corr.ci_b, 5)],
+            ["c" + ("" if corr.prandtl_exponent_fitted else " (fixed)"), _fmt(corr.c, 6),
+             _fmt(corr.se_c, 3), _fmt(corr.ci_c, 5)],
+        ],
+        note=corr.note,
+    )
+    t = corr.anova
+    anova = _Table(
+        "Table 8. Analysis of variance of the non-linear correlation",
+        ["Source of variance", "Sum of squares", "Degrees of freedom", "Mean square",
+         "F observed", "P-value"],
+        [
+            ["Model", _fmt(t.ss_model, 6), _fmt(t.df_model), _fmt(t.ms_model, 6),
+             _fmt(t.f_value, 6), f"{t.p_value:.4f}"],
+            ["Error", _fmt(t.ss_error, 6), _fmt(t.df_error), _fmt(t.ms_error, 6), "", ""],
+            ["Total", _fmt(t.ss_total, 6), _fmt(t.df_total), "", "", ""],
+            ["Adjusted R-squared (%)", _fmt(100 * corr.adjusted_r_squared, 6), "", "", "", ""],
+        ],
+        note=(
+            f"{corr.n:,} steps used, {corr.n_dropped:,} dropped (masked or non-positive); valid "
+            f"for {corr.reynolds_range[0]:.5g} < Re < {corr.reynolds_range[1]:.5g}. Uncorrected "
+            "sums of squares as in Statgraphics; R-squared against the corrected total."
+        ),
+    )
+    return [coef, anova]
+
+
+def _figure9(names: list[str], results: list[MethodologyResult | None],
+             corr: NusseltCorrelation | None) -> _Figure:
+    fig = _Figure("Nusselt against Reynolds (Figure 9)")
+    pairs = [(n, r) for n, r in zip(names, results, strict=True) if r is not None]
+    if not pairs:
+        fig.note = "no run could be analysed, so there are no Nusselt and Reynolds numbers"
+        return fig
+    pr_all = np.concatenate([r.prandtl[np.isfinite(r.prandtl)] for _, r in pairs])
+    pr_mean = float(pr_all.mean()) if pr_all.size else math.nan
+
+    def draw(ax: Any) -> None:
+        re_all = []
+        for n, r in pairs:
+            ok = np.isfinite(r.nusselt) & (r.nusselt > 0)
+            ax.plot(r.reynolds[ok], r.nusselt[ok], ".", ms=3, alpha=0.6, label=n)
+            re_all.append(r.reynolds[ok])
+        re_cat = np.concatenate(re_all) if re_all else np.array([])
+        if corr is not None and re_cat.size:
+            grid = np.linspace(re_cat.min(), re_cat.max(), 200)
+            ax.plot(grid, corr.a * grid**corr.b * pr_mean**corr.c, color="black", lw=1.4,
+                    label=f"Nu = {corr.a:.4g} Re^{corr.b:.4g} Pr^{corr.c:.4g}")
+        if re_cat.size and re_cat.max() > 10 * re_cat.min() > 0:
+            ax.set_xscale("log")
+            ax.set_yscale("log")
+        else:
+            # Plain tick labels: one run spans a tiny Re range, and an offset label such as
+            # "+9.27e4" hides the values.
+            ax.ticklabel_format(useOffset=False, style="plain")
+        ax.set_xlabel("Re (Eq. 51)")
+        ax.set_ylabel("Nu (Eq. 49)")
+        ax.set_title(f"Pr = {pr_mean:.4g}", fontsize=9)
+        ax.legend(fontsize=8)
+        ax.grid(alpha=0.3)
+
+    fig.uri = _fig_uri(draw)
+    k = {r.nusselt_conductivity for _, r in pairs}
+    fig.caption = (
+        "per-step values of the valid steps; Nu with the "
+        + " / ".join(sorted(k)) + " conductivity"
+        + ("" if corr is not None else "; no fitted curve (see Table 8)")
+    )
+    return fig
+
+
+def _comparison(names: list[str], results: list[MethodologyResult | None],
+                why_not: list[str | None]) -> _Table:
+    rows = []
+    for name, r, why in zip(names, results, why_not, strict=True):
+        if r is None:
+            rows.append([name, "–", "–", "–", "–", "–", "–", "–",
+                         "not analysed, see its section" if why else ""])
+            continue
+        rows.append([
+            name,
+            _fmt(r.case.particles.diameter * 1e3),
+            _fmt(r.case.drum.rpm),
+            _fmt(r.case.air.mass_flow),
+            _fmt(r.h_mean_w_m2k),
+            _fmt(float(np.nanmean(r.reynolds))),
+            _fmt(float(np.nanmean(r.nusselt))),
+            _fmt(r.exchanger.material_outlet_temperature_c),
+            "; ".join(r.warnings),
+        ])
+    return _Table(
+        "Runs",
+        ["run", "Dp (mm)", "rpm", "air (kg/s)", "h (W/(m² K))", "mean Re", "mean Nu",
+         "T_mo (°C)", "note"],
+        rows,
+    )
+
+
+# ------------------------------------------------------------------------------ template
+
+_TEMPLATE = """<!DOCTYPE html>
+<html lang="en">
+<head>
+<meta charset="utf-8">
+<meta name="viewport" content="width=device-width, initial-scale=1">
+<title>{{ title }}</title>
+<style>
+body { font-family: system-ui, -apple-system, "Segoe UI", Roboto, sans-serif; margin: 2em auto;
+       max-width: 1150px; padding: 0 1em; color: #222; line-height: 1.4; }
+h1 { font-size: 1.6em; border-bottom: 2px solid #c33; padding-bottom: .2em; }
+h2 { font-size: 1.3em; margin-top: 2em; border-bottom: 1px solid #ccc; }
+h3 { font-size: 1.05em; margin-top: 1.4em; }
+table { border-collapse: collapse; margin: .6em 0 1.2em; font-size: .9em; }
+caption { text-align: left; font-weight: 600; padding: .3em 0; }
+th, td { border: 1px solid #ccc; padding: .25em .6em; text-align: right; }
+th:first-child, td:first-child { text-align: left; }
+thead th { background: #f2f2f2; }
+tbody tr:nth-child(even) { background: #fafafa; }
+.note { background: #fff6e0; border-left: 4px solid #e0a000; padding: .4em .8em; margin: .6em 0; }
+.tnote { font-size: .85em; color: #555; margin-top: -.8em; }
+figure { margin: 1em 0 1.6em; }
+figure img { max-width: 100%; border: 1px solid #ddd; }
+figcaption { font-size: .85em; color: #555; }
+pre { background: #f6f6f6; padding: .8em; overflow-x: auto; font-size: .8em; }
+.meta { color: #666; font-size: .9em; }
+.eq { font-family: "Latin Modern Math", "STIX Two Math", serif; font-size: 1.1em; }
+</style>
+</head>
+<body>
+<h1>{{ title }}</h1>
+<p class="meta">drumflow {{ version }}, {{ generated }}. Method of Burgos-Florez et al.,
+Processes 2019, 7, 673 (Sections 2.2-2.5). Nu uses the {{ conductivity }} conductivity;
+falling mass per step: {{ falling_mass }}.</p>
+{% if runs|length > 1 %}<ul>{% for run in runs %}
+<li><a href="#{{ run.anchor }}">{{ run.name }}</a> <span class="meta">{{ run.path }}</span></li>
+{% endfor %}</ul>{% endif %}
+{% for note in notes %}<p class="note">{{ note }}</p>{% endfor %}
+
+{% macro table(t) -%}
+<table>
+<caption>{{ t.caption }}</caption>
+<thead><tr>{% for h in t.header %}<th>{{ h }}</th>{% endfor %}</tr></thead>
+<tbody>{% for row in t.rows %}
+<tr>{% for cell in row %}<td>{{ cell }}</td>{% endfor %}</tr>{% endfor %}
+</tbody>
+</table>
+{% if t.note %}<p class="tnote">{{ t.note }}</p>{% endif %}
+{%- endmacro %}
+
+{% macro figure(f) -%}
+<figure>
+<h3>{{ f.title }}</h3>
+{% if f.uri %}<img src="{{ f.uri }}" alt="{{ f.title }}">{% endif %}
+{% if f.note %}<p class="note">{{ f.note }}</p>{% endif %}
+{% if f.caption %}<figcaption>{{ f.caption }}</figcaption>{% endif %}
+</figure>
+{%- endmacro %}
+
+<h2>Heat transfer and exchanger model</h2>
+{% if comparison %}{{ table(comparison) }}{% endif %}
+{{ table(table6) }}
+{% if table7.header|length > 1 %}{{ table(table7) }}{% else %}
+<p class="note">Table 7 (exchanger model) is not available: no run could be analysed.</p>{% endif %}
+
+<h2>Correlation</h2>
+{% if table8 %}<p class="eq">{{ equation }}</p>{% for t in table8 %}{{ table(t) }}{% endfor %}
+{% else %}<p class="note">Table 8 (correlation and ANOVA) is not available: {{ no_fit }}</p>{% endif %}
+{{ figure(figure9) }}
+
+{% for run in runs %}
+<h2 id="{{ run.anchor }}">Run {{ run.name }}</h2>
+<p class="meta">{{ run.path }}</p>
+{% for note in run.notes %}<p class="note">{{ note }}</p>{% endfor %}
+{% for t in run.tables %}{{ table(t) }}{% endfor %}
+{% for f in run.figures %}{{ figure(f) }}{% endfor %}
+{% if run.manifest_json %}<details><summary>manifest.json</summary>
+<pre>{{ run.manifest_json }}</pre></details>
+{% else %}<p class="note">no manifest.json in this run directory</p>{% endif %}
+{% endfor %}
+</body>
+</html>
+"""
+
+
+def write_report(
+    run_dirs: Sequence[Path | str],
+    out: Path | str,
+    *,
+    nusselt_conductivity: NusseltConductivity = "air",
+    falling_mass: FallingMassMode = "mean",
+    render_3d: bool = True,
+    render_timeout_s: float = 180.0,
+) -> Path:
+    """Write one self-contained HTML page for one run or a sweep of runs.
+
+    Parameters
+    ----------
+    run_dirs
+        Run directories written by ``drumflow run`` (at least one).
+    out
+        HTML file to write (its folder is created if needed).
+    nusselt_conductivity, falling_mass
+        Passed to :func:`~drumflow.analysis.methodology.analyse_run`.
+    render_3d
+        Render the last snapshot with PyVista (Figure 6). Off makes the page faster.
+    render_timeout_s
+        Time limit of each PyVista render (it runs in a child process).
+
+    Returns
+    -------
+    pathlib.Path
+        The HTML file (absolute).
+
+    Raises
+    ------
+    RunDirectoryError
+        If no run directory is given or one of them is not a directory.
+    """
+    from jinja2 import Environment, StrictUndefined
+
+    import drumflow
+
+    roots = [Path(p).resolve() for p in run_dirs]
+    if not roots:
+        raise RunDirectoryError("no run directory given for the report")
+    for root in roots:
+        if not root.is_dir():
+            raise RunDirectoryError(f"{root}: not a directory (expected a `drumflow run` directory)")
+
+    results: list[MethodologyResult | None] = []
+    why_not: list[str | None] = []
+    for root in roots:
+        try:
+            results.append(analyse_run(root, nusselt_conductivity=nusselt_conductivity,
+                                       falling_mass=falling_mass))
+            why_not.append(None)
+        except DrumflowError as exc:
+            # A run without air or without its CSV still gets its page, with the reason.
+            results.append(None)
+            why_not.append(str(exc))
+
+    views = [
+        _run_view(i, root, res, why, render_3d, render_timeout_s)
+        for i, (root, res, why) in enumerate(zip(roots, results, why_not, strict=True))
+    ]
+    names = [v.name for v in views]
+    ok = [r for r in results if r is not None]
+    corr: NusseltCorrelation | None = None
+    no_fit = ""
+    if not ok:
+        no_fit = "no run could be analysed (see the notes of each run)."
+    else:
+        try:
+            corr = fit_runs(ok)
+        except AnalysisInputError as exc:
+            hint = (
+                " A single run cannot identify the exponent b, because Re then changes only "
+                "through the air viscosity. Combine runs with different particle diameters or "
+                "air flows."
+                if len(ok) == 1
+                else ""
+            )
+            no_fit = f"the correlation could not be fitted: {exc}.{hint}"
+
+    page_notes: list[str] = []
+    if len(ok) < len(results):
+        page_notes.append(
+            f"{len(results) - len(ok)} of {len(results)} run(s) could not be analysed for heat "
+            "transfer; their observables are shown below with the reason."
+        )
+    title = (
+        f"drumflow report: {names[0]}" if len(names) == 1
+        else f"drumflow report: sweep of {len(names)} runs"
+    )
+    env = Environment(autoescape=True, undefined=StrictUndefined, trim_blocks=True,
+                      lstrip_blocks=True)
+    html = env.from_string(_TEMPLATE).render(
+        title=title,
+        version=drumflow.__version__,
+        generated=time.strftime("%Y-%m-%d %H:%M:%S %z"),
+        conductivity=nusselt_conductivity,
+        falling_mass=falling_mass,
+        notes=page_notes,
+        runs=views,
+        comparison=_comparison(names, results, why_not) if len(roots) > 1 else None,
+        table6=_table6(names, results),
+        table7=_table7(names, results),
+        table8=_table8(corr) if corr is not None else None,
+        equation=(
+            f"Nu = {corr.a:.6g} Re^{corr.b:.6g} Pr^{corr.c:.6g}, "
+            f"{corr.reynolds_range[0]:.5g} < Re < {corr.reynolds_range[1]:.5g}"
+            if corr is not None else ""
+        ),
+        no_fit=no_fit,
+        figure9=_figure9(names, results, corr),
+    )
+    target = Path(out).resolve()
+    target.parent.mkdir(parents=True, exist_ok=True)
+    target.write_text(html, encoding="utf-8")
+    return target
