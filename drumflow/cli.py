@@ -165,6 +165,202 @@ def post(
     _print_summary(summary, run_dir, as_json)
 
 
+def _exchanger_rows(table: Table, r, label_suffix: str = "") -> None:  # type: ignore[no-untyped-def]
+    rows = [
+        ("material inlet T_mi (°C)", f"{r.material_inlet_temperature_c:.2f}"),
+        ("material outlet T_mo (°C)", f"{r.material_outlet_temperature_c:.2f}"),
+        ("air inlet T_ai (°C)", f"{r.air_inlet_temperature_c:.2f}"),
+        ("air outlet T_ao (°C)", f"{r.air_outlet_temperature_c:.2f}"),
+        ("thermal power Q_m (kW)", f"{r.heat_removed_w / 1e3:.2f}"),
+        ("LMTD_he (°C)", f"{r.lmtd_c:.2f}"),
+        ("h (W/(m² K))", f"{r.h_w_m2k:.4g}"),
+        ("exchanged heat Q_he (kW)", f"{r.heat_exchanged_w / 1e3:.2f}"),
+        ("area A_he (m²)", f"{r.area_m2:.2f}"),
+    ]
+    for label, value in rows:
+        table.add_row(label + label_suffix, value)
+
+
+@app.command()
+def exchanger(
+    case_file: Annotated[Path, typer.Argument(help="case file (TOML); its plant and air sections give the streams")],
+    h: Annotated[float, typer.Option("--h", help="heat-transfer coefficient, W/(m² K)")],
+    area: Annotated[Optional[float], typer.Option("--area", help="exchange area A_he, m²: solve T_mo")] = None,
+    outlet_temperature: Annotated[
+        Optional[float],
+        typer.Option("--outlet-temperature", help="material outlet T_mo, °C: solve A_he "
+                     "(default: plant.material_outlet_temperature_C when --area is not given)"),
+    ] = None,
+    as_json: Annotated[bool, typer.Option("--json", help="print the result as JSON")] = False,
+) -> None:
+    """The cooler as a counter-current exchanger (Eqs. 42-48, Table 7)."""
+    from drumflow.analysis.exchanger import counter_current_exchanger
+    from drumflow.analysis.methodology import exchanger_to_dict, plant_streams
+
+    try:
+        case = _load(case_file)
+        if area is not None and outlet_temperature is not None:
+            raise typer.BadParameter("give --area or --outlet-temperature, not both")
+        if area is None and outlet_temperature is None:
+            outlet_temperature = case.plant.material_outlet_temperature_C
+            if outlet_temperature is None:
+                raise typer.BadParameter(
+                    "give --area A (solve T_mo) or --outlet-temperature T (solve A_he), or set "
+                    "plant.material_outlet_temperature_C in the case"
+                )
+        result = counter_current_exchanger(
+            h_w_m2k=h, area_m2=area, material_outlet_temperature_c=outlet_temperature,
+            **plant_streams(case),
+        )
+    except (DrumflowError, typer.BadParameter) as exc:
+        _fail(exc, 2)
+        return
+    if as_json:
+        console.print_json(json.dumps({"case": case.name, **exchanger_to_dict(result)}))
+        return
+    solved = "T_mo" if area is not None else "A_he"
+    table = Table(title=f"{case.name}: counter-current exchanger, solved for {solved}", show_header=False)
+    _exchanger_rows(table, result)
+    console.print(table)
+
+
+@app.command()
+def predict(
+    run_dir: Annotated[Path, typer.Argument(help="reference run directory (a run of the case, with air)")],
+    h: Annotated[Optional[float], typer.Option("--h", help="fixed h, W/(m² K) (default: the run's mean h)")] = None,
+    fit_with: Annotated[
+        Optional[list[Path]],
+        typer.Option("--fit-with", help="more run directories: fit Nu = a Re^b Pr^c to all runs "
+                     "and use it instead of a fixed h (repeat the option)"),
+    ] = None,
+    rpm: Annotated[Optional[float], typer.Option("--rpm", help="new rotation speed, 1/min")] = None,
+    air_flow: Annotated[Optional[float], typer.Option("--air-flow", help="new air mass flow, kg/s")] = None,
+    feed_rate: Annotated[Optional[float], typer.Option("--feed-rate", help="new feed rate, kg/s")] = None,
+    particle_diameter: Annotated[
+        Optional[float], typer.Option("--particle-diameter", help="new particle diameter, m")
+    ] = None,
+    conductivity: Annotated[
+        str, typer.Option("--conductivity", help="k in Nu = h Dp / k: 'air' or 'particle' (the paper's)")
+    ] = "air",
+    assumptions: Annotated[bool, typer.Option("--assumptions", help="also print the scaling assumptions")] = False,
+    as_json: Annotated[bool, typer.Option("--json", help="print the prediction as JSON")] = False,
+) -> None:
+    """Predict the plant outlet temperatures at a new rpm, air flow, feed rate or particle size."""
+    from drumflow.analysis.methodology import analyse_run, fit_runs
+    from drumflow.analysis.predict import predict_plant
+
+    try:
+        reference = analyse_run(run_dir, nusselt_conductivity=conductivity)  # type: ignore[arg-type]
+        if fit_with and h is not None:
+            raise typer.BadParameter("give --h or --fit-with, not both")
+        source = (
+            fit_runs([reference, *fit_with], nusselt_conductivity=conductivity)  # type: ignore[arg-type]
+            if fit_with
+            else (reference.h_mean_w_m2k if h is None else h)
+        )
+        pred = predict_plant(
+            source, reference.case, reference=reference, rpm=rpm, air_mass_flow=air_flow,
+            feed_rate=feed_rate, particle_diameter=particle_diameter,
+            nusselt_conductivity=conductivity,  # type: ignore[arg-type]
+        )
+    except (DrumflowError, typer.BadParameter) as exc:
+        _fail(exc, 2)
+        return
+    if as_json:
+        console.print_json(json.dumps(pred.to_dict()))
+        return
+    table = Table(title=f"{reference.case.name}: plant prediction (h from {pred.h_source})")
+    table.add_column("")
+    table.add_column("case", justify="right")
+    table.add_column("predicted", justify="right")
+    ref, new = pred.reference, pred.conditions
+    ex0, ex1 = pred.reference_exchanger, pred.exchanger
+    for label, a, b, fmt in [
+        ("rotation (rpm)", ref.rpm, new.rpm, "{:.4g}"),
+        ("air flow (kg/s)", ref.air_mass_flow_kg_s, new.air_mass_flow_kg_s, "{:.4g}"),
+        ("feed rate (kg/s)", ref.feed_rate_kg_s, new.feed_rate_kg_s, "{:.4g}"),
+        ("particle diameter (mm)", ref.particle_diameter_m * 1e3, new.particle_diameter_m * 1e3, "{:.4g}"),
+        ("Re", pred.reference_reynolds, pred.reynolds, "{:.5g}"),
+        ("h (W/(m² K))", pred.reference_h_w_m2k, pred.h_w_m2k, "{:.4g}"),
+        ("area A_he (m²)", pred.reference_exchanger_area_m2, pred.exchanger_area_m2, "{:.2f}"),
+        ("material outlet T_mo (°C)", ex0.material_outlet_temperature_c, ex1.material_outlet_temperature_c, "{:.2f}"),
+        ("air outlet T_ao (°C)", ex0.air_outlet_temperature_c, ex1.air_outlet_temperature_c, "{:.2f}"),
+        ("thermal power Q_m (kW)", ex0.heat_removed_w / 1e3, ex1.heat_removed_w / 1e3, "{:.2f}"),
+    ]:
+        table.add_row(label, fmt.format(a), fmt.format(b))
+    console.print(table)
+    for warning in pred.warnings:
+        err_console.print(f"[bold yellow]warning:[/] {warning}", highlight=False)
+    if assumptions:
+        for i, text in enumerate(pred.assumptions, 1):
+            console.print(f"{i}. {text}", highlight=False)
+
+
+@app.command()
+def report(
+    run_dirs: Annotated[list[Path], typer.Argument(help="run directories (one run or a sweep)")],
+    out: Annotated[Path, typer.Option("--out", "-o", help="HTML file to write")],
+    conductivity: Annotated[
+        str, typer.Option("--conductivity", help="k in Nu = h Dp / k: 'air' or 'particle' (the paper's)")
+    ] = "air",
+    render_3d: Annotated[bool, typer.Option("--3d/--no-3d", help="PyVista picture of the last snapshot")] = True,
+    as_json: Annotated[bool, typer.Option("--json", help="print the report path as JSON")] = False,
+) -> None:
+    """One self-contained HTML page: case, Tables 6-8, Figures 4, 6-9, manifest."""
+    from drumflow.report.html import write_report
+
+    try:
+        path = write_report(run_dirs, out, nusselt_conductivity=conductivity,  # type: ignore[arg-type]
+                            render_3d=render_3d)
+    except DrumflowError as exc:
+        _fail(exc, 2)
+        return
+    if as_json:
+        console.print_json(json.dumps({"report": str(path), "runs": [str(p) for p in run_dirs]}))
+        return
+    console.print(f"report written to {path}", highlight=False)
+
+
+@app.command()
+def methodology(
+    run_dir: Annotated[Path, typer.Argument(help="run directory written by `drumflow run` (with air)")],
+    conductivity: Annotated[
+        str, typer.Option("--conductivity", help="k in Nu = h Dp / k: 'air' or 'particle' (the paper's)")
+    ] = "air",
+    falling_mass: Annotated[
+        str, typer.Option("--falling-mass", help="'mean' (the paper's averaged m_mf) or 'per_step'")
+    ] = "mean",
+    as_json: Annotated[bool, typer.Option("--json", help="print the result as JSON")] = False,
+) -> None:
+    """Heat-transfer coefficient, Nu/Re/Pr and the exchanger model of one run (Tables 6-7)."""
+    from drumflow.analysis.methodology import analyse_run, write_methodology
+
+    try:
+        result = analyse_run(run_dir, nusselt_conductivity=conductivity,  # type: ignore[arg-type]
+                             falling_mass=falling_mass)  # type: ignore[arg-type]
+        json_path, csv_path = write_methodology(run_dir, result)
+    except DrumflowError as exc:
+        _fail(exc, 2)
+        return
+    if as_json:
+        console.print_json(json.dumps(result.to_dict()))
+        return
+    table = Table(title=f"{result.case.name}: heat transfer (Table 6) → {json_path}", show_header=False)
+    table.add_row("time step dt (s)", f"{result.dt_s:.4g}")
+    table.add_row("air mass per step (kg)", f"{result.air_mass_per_step_kg:.4g}")
+    table.add_row("falling mass per step (kg)", f"{result.falling_mass_per_step_kg:.4g}")
+    table.add_row("falling area A_fp (m²)", f"{result.falling_area_m2:.4g}")
+    table.add_row("mean h (W/(m² K))", f"{result.h_mean_w_m2k:.4g}")
+    table.add_row("valid steps", f"{result.n_valid:,} of {result.n_steps:,}")
+    _exchanger_rows(table, result.exchanger, " [model]")
+    if result.plant_exchanger is not None:
+        _exchanger_rows(table, result.plant_exchanger, " [plant]")
+    console.print(table)
+    for warning in result.warnings:
+        err_console.print(f"[bold yellow]warning:[/] {warning}", highlight=False)
+    console.print(f"per-step table: {csv_path}", highlight=False)
+
+
 def main() -> None:
     """Console-script entry point."""
     try:

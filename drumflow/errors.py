@@ -90,21 +90,33 @@ class LostParticlesError(SolverError):
 
     Attributes
     ----------
-    initial, final
-        Particle counts before and after the loss.
+    initial
+        Particles at the start of the run.
+    final
+        The last count seen, or ``None`` when LIGGGHTS stopped before printing one (its own
+        "Lost atoms: original N current M" message is not trusted: the Debian build of
+        LIGGGHTS 3.8 prints wrong numbers there).
+    time_s
+        Simulated time of the last count seen, if any.
     """
 
-    def __init__(self, initial: int, final: int, log: Path | None, command: Sequence[str] = ()) -> None:
+    def __init__(
+        self,
+        initial: int,
+        final: int | None,
+        log: Path | None,
+        command: Sequence[str] = (),
+        time_s: float | None = None,
+    ) -> None:
         self.initial = initial
         self.final = final
-        super().__init__(
-            "liggghts",
-            command,
-            None,
-            log,
-            reason=f"{initial - final} of {initial} particles left the domain "
-            f"(initial {initial}, final {final})",
-        )
+        self.time_s = time_s
+        if final is not None and final < initial:
+            what = f"{initial - final} of {initial} particles left the domain"
+        else:
+            what = f"particles left the domain (of {initial} at the start)"
+        when = f" after {time_s:.4g} s simulated" if time_s is not None else ""
+        super().__init__("liggghts", command, None, log, reason=what + when)
 
 
 class InsertionError(DrumflowError, RuntimeError):

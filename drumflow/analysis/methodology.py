@@ -481,8 +481,8 @@ def analyse_run(
         raise NoHeatTransferError(
             f"{case_path}: the run had no air ({why}), so h cannot be measured: without air the "
             "mean particle temperature changes only by conduction between particles, and "
-            "Eqs. 34-39 need the air to take the heat. Rerun with air.model = 'uniform' or 'cfd' "
-            "and air.mass_flow > 0."
+            "Eqs. 34-39 need the air to take the heat. It needs a run with air acting on the "
+            "particles (air.model 'uniform' or 'cfd', which this version does not have yet)."
         )
 
     table = _read_mean_temperature(csv_path)
@@ -736,4 +736,6 @@ def fit_runs(
         for r in run_dirs
     ]
     fit_kwargs.setdefault("drop_nonpositive", True)
-    return fit_nusselt_correlation_from_runs(results, **fit_kwargs)
+    return fit_nusselt_correlation_from_runs(
+        [(r.nusselt, r.reynolds, r.prandtl) for r in results], **fit_kwargs
+    )

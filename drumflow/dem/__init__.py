@@ -32,7 +32,7 @@ __all__ = ["DemResult", "ThermoParser", "run_dem", "dem_key"]
 #: progress(stage, done, total): simulated seconds done out of the total.
 ProgressCallback = Callable[[str, float, float], None]
 
-_LOST_RE = re.compile(r"Lost atoms: original (\d+) current (\d+)")
+_LOST_RE = re.compile(r"Lost atoms")
 
 
 @dataclass(frozen=True)
@@ -158,9 +158,12 @@ def run_dem(
             follow=own_log,
         )
     except SolverError as err:
-        lost = _LOST_RE.search(f"{err.reason} {err.last_error}")
-        if lost:
-            raise LostParticlesError(int(lost.group(1)), int(lost.group(2)), log, command) from None
+        if _LOST_RE.search(f"{err.reason} {err.last_error}"):
+            last = parser.rows[-1] if parser.rows else None
+            final = int(last[2]) if last is not None and int(last[2]) < n else None
+            raise LostParticlesError(
+                n, final, log, command, time_s=None if last is None else last[1]
+            ) from None
         raise
     finally:
         rundir.record_commands([r.as_dict() for r in runner.records if r.program == "liggghts"][-1:])

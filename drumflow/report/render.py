@@ -19,6 +19,7 @@ import subprocess
 import sys
 import tempfile
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -113,7 +114,8 @@ def render_particles(
 
     cloud = pv.PolyData(pts)
     cloud["temperature (deg C)"] = temp
-    plotter = pv.Plotter(off_screen=True, window_size=list(window_size))
+    # Any: PyVista's method decorators confuse static checkers (they see unbound wrappers).
+    plotter: Any = pv.Plotter(off_screen=True, window_size=list(window_size))
     try:
         plotter.set_background("white")
         lo, hi = float(temp.min()), float(temp.max())
