@@ -380,7 +380,7 @@ def case_from_dict(data: dict[str, Any], source: Path | str | None = None) -> Ca
     try:
         return Case.model_validate(data)
     except ValidationError as exc:
-        raise CaseError(_merge_problems(exc.errors()), source) from None
+        raise CaseError(_merge_problems([dict(e) for e in exc.errors()]), source) from None
 
 
 def load_case(path: Path | str) -> Case:

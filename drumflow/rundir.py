@@ -54,12 +54,14 @@ def _dpkg_version(package: str) -> str | None:
         )
     except (OSError, subprocess.TimeoutExpired):
         return None
-    return out.stdout.strip() or None if out.returncode == 0 else None
+    if out.returncode != 0:
+        return None
+    return out.stdout.strip() or None
 
 
 def software_versions() -> dict[str, Any]:
     """Versions of drumflow, the solvers, Python and the Python packages it uses."""
-    packages = {}
+    packages: dict[str, str | None] = {}
     for name in ("drumflow", "numpy", "scipy", "pandas", "gmsh", "meshio", "pyvista", "pydantic",
                  "jinja2", "foamlib", "matplotlib", "typer", "rich"):
         try:

@@ -45,7 +45,7 @@ import math
 import warnings
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Protocol
+from typing import TYPE_CHECKING, Any, Protocol
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -528,6 +528,7 @@ def fit_nusselt_correlation_from_runs(
     res: list[NDArray[np.float64]] = []
     prs: list[NDArray[np.float64]] = []
     for i, run in enumerate(runs):
+        triple: tuple[Any, ...]
         if all(hasattr(run, k) for k in ("nusselt", "reynolds", "prandtl")):
             triple = (run.nusselt, run.reynolds, run.prandtl)  # type: ignore[union-attr]
         else:

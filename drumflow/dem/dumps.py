@@ -123,7 +123,7 @@ def read_series(
     if not files:
         raise RunDirectoryError(f"{folder}: no dump files ({prefix}.*.txt)")
     snaps = [read_dump(f) for f in files]
-    for f, s in zip(files, snaps):
+    for f, s in zip(files, snaps, strict=True):
         missing = [c for c in columns if c not in s.columns]
         if missing:
             raise RunDirectoryError(f"{f}: dump lacks column(s) {', '.join(missing)}")
@@ -136,7 +136,7 @@ def read_series(
     steps = np.array([s.step for s in snaps], dtype=np.int64)
     return DumpSeries(
         steps=steps,
-        times=steps * time_step,
+        times=(steps * time_step).astype(np.float64),
         ids=ids,
         fields=fields,
         counts=np.array([len(s) for s in snaps], dtype=np.int64),
@@ -179,4 +179,4 @@ def read_rows(folder: Path, time_step: float, prefix: str = "cross") -> DumpRows
     ids = np.concatenate([s.ids for s in snaps])
     fields = {n: np.concatenate([s.columns[n] for s in snaps]) for n in names}
     steps = np.array([s.step for s in snaps], dtype=np.int64)
-    return DumpRows(steps, steps * time_step, frame, ids, fields)
+    return DumpRows(steps, (steps * time_step).astype(np.float64), frame, ids, fields)

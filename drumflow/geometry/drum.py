@@ -167,7 +167,7 @@ def build_wall_mesh(case: Case, size: float | None = None) -> WallMesh:
         tris: list[NDArray[np.int64]] = []
         for tag in groups["walls"]:
             etypes, _, enodes = gmsh.model.mesh.getElements(2, tag)
-            for etype, nodes in zip(etypes, enodes):
+            for etype, nodes in zip(etypes, enodes, strict=True):
                 if etype != 2:  # 3-node triangles only; anything else means a bad mesh
                     raise GeometryError(f"unexpected gmsh element type {etype} on the walls")
                 tris.append(index[nodes.astype(np.int64)].reshape(-1, 3))
