@@ -157,6 +157,22 @@ class Air(_Section):
     inlet_temperature_C: float = Field(30.0, gt=-60, lt=500)
     pressure_kPa: float = Field(101.3, gt=10, lt=1000)
     heat_capacity: float = Field(1005.0, gt=0, description="air specific heat, J/(kg K)")
+    mesh_size: float | Literal["auto"] = Field(
+        "auto", description="fluid mesh cell size, m; 'auto' = drum diameter / 20"
+    )
+    turbulence: Literal["realizableKE", "laminar"] = Field(
+        "realizableKE", description="RANS model of the air (the paper: realizable k-epsilon)"
+    )
+    residual_target: float = Field(
+        1e-4, gt=0, lt=1, description="steady solver stops when all initial residuals fall below"
+    )
+    max_iterations: int = Field(2000, ge=10, le=100_000, description="SIMPLE iteration limit")
+    coupling_interval: int | Literal["auto"] = Field(
+        "auto", description="DEM steps between air-on-particle updates; 'auto' from the N-sweep"
+    )
+    pressure_gradient_force: bool = Field(
+        False, description="add the pressure-gradient force of Eq. 4 to the drag"
+    )
 
 
 class Run(_Section):
