@@ -22,12 +22,16 @@ from drumflow.analysis.observables import (
     mean_temperature,
 )
 from drumflow.case import Case, case_to_toml, load_case
+from drumflow.air import prepare_air
+from drumflow.coupling.log import read_coupling
 from drumflow.dem import ProgressCallback, run_dem
+from drumflow.dem.deck import plan_steps
+from drumflow.dem.timestep import choose_time_step
 from drumflow.dem.dumps import read_rows, read_series
 from drumflow.dem.thermo import read_thermo
 from drumflow.errors import CaseError, RunDirectoryError
 from drumflow.geometry import build_geometry
-from drumflow.report.plots import plot_crossings, plot_mean_temperature, plot_particles
+from drumflow.report.plots import plot_air_heat, plot_crossings, plot_mean_temperature, plot_particles
 from drumflow.rundir import RunDir
 from drumflow.runner import LaunchProfile, Runner
 
@@ -36,12 +40,12 @@ __all__ = ["run_case", "post_run", "refuse_unavailable"]
 
 def refuse_unavailable(case: Case) -> None:
     """Raise :class:`CaseError` for features the case asks for that this version lacks."""
-    if case.air.model != "none":
-        # Say so before any solver starts, rather than silently run without air.
+    if case.air.pressure_gradient_force:
+        # Say so before any solver starts, rather than silently run without it.
         raise CaseError(
             [
-                f"air.model = {case.air.model!r}: the air field is not available in this "
-                "version of drumflow; allowed: 'none'"
+                "air.pressure_gradient_force = true: the pressure-gradient force (Eq. 4) is not "
+                "available in this version; allowed: false"
             ]
         )
 
@@ -88,7 +92,14 @@ def run_case(
     geometry = build_geometry(case, rundir)
     if progress:
         progress("geometry", 1.0, 1.0)
-    dem = run_dem(case, rundir, runner, geometry, progress=progress, steps=steps, timeout=timeout)
+    plan = plan_steps(case, choose_time_step(case))
+    air = prepare_air(case, rundir, runner, plan.time_step, plan.dump_every)
+    if air is not None:
+        rundir.record("air", asdict(air[1]))
+        if progress:
+            progress("air", 1.0, 1.0)
+    dem = run_dem(case, rundir, runner, geometry, progress=progress, steps=steps, timeout=timeout,
+                  air=None if air is None else air[0])
     if steps is not None:
         summary = {
             "case": case.name,
@@ -127,7 +138,7 @@ def post_run(out: Path | str, case: Case | None = None) -> dict[str, Any]:
         raise RunDirectoryError(f"{root}/manifest.json: no DEM time step recorded; rerun the case")
     t0 = time.perf_counter()
     dumps = rundir.dem / "dumps"
-    thermo = read_thermo(rundir.dem)
+    thermo = read_thermo(rundir.dem, every=rundir.manifest.get("output_every"))
     if thermo.empty:
         raise RunDirectoryError(f"{rundir.dem}: no LIGGGHTS thermo output (log.liggghts)")
     times = thermo["step"].to_numpy() * float(ts)
@@ -166,6 +177,8 @@ def post_run(out: Path | str, case: Case | None = None) -> dict[str, Any]:
                    post / "particles_final.png", f"{title}, t = {snaps.times[-1]:.2f} s",
                    time_s=float(snaps.times[-1]))
 
+    air_info = _post_air(rundir, case, float(ts), times, T_mean)
+
     final = int(thermo["atoms"].iloc[-1])
     problems = []
     if final != case.particle_count:
@@ -189,6 +202,7 @@ def post_run(out: Path | str, case: Case | None = None) -> dict[str, Any]:
         "falling_window_s": [flow.window_start_s, flow.window_end_s],
         "output_steps": int(len(times)),
         "snapshots": int(len(snaps.times)),
+        **air_info,
         "post_read_s": read_s,
         "post_wall_time_s": time.perf_counter() - t0,
     }
@@ -197,3 +211,30 @@ def post_run(out: Path | str, case: Case | None = None) -> dict[str, Any]:
     merged = {**old, **summary}
     rundir.summary_path.write_text(json.dumps(merged, indent=2))
     return merged
+
+
+def _post_air(rundir: RunDir, case: Case, time_step: float, times: np.ndarray, T_mean: np.ndarray) -> dict[str, Any]:
+    """Heat the air took from the particles, its plot, and the energy balance check."""
+    coupling = read_coupling(rundir.dem / "coupling", time_step)
+    if coupling.empty:
+        return {}
+    coupling.to_csv(rundir.post / "air_heat.csv", index=False, float_format="%.10g")
+    removed = float(coupling["heat_removed_J"].iloc[-1])
+    # The particles' enthalpy loss, from LIGGGHTS' mass-weighted mean temperature: an
+    # independent route to the same number (conduction only moves heat between particles).
+    loss = case.particle_mass_total * case.particles.heat_capacity * float(T_mean[0] - T_mean[-1])
+    closure = abs(loss - removed) / abs(removed) if removed else float("nan")
+    plot_air_heat(coupling, rundir.post / "air_heat.png", f"{case.name}: heat removed by the air")
+    air = rundir.manifest.get("air", {})
+    return {
+        "air_model": case.air.model,
+        "air_mass_flow_in_kg_s": air.get("mass_flow_in_kg_s"),
+        "air_mass_flow_out_kg_s": air.get("mass_flow_out_kg_s"),
+        "air_mean_axial_velocity_m_s": air.get("mean_axial_velocity_m_s"),
+        "air_coupling_interval_steps": air.get("coupling_interval_steps"),
+        "air_field_cache_hit": air.get("cache_hit"),
+        "heat_removed_by_air_J": removed,
+        "particle_enthalpy_loss_J": loss,
+        "energy_balance_error": closure,
+        "mean_heat_removal_W": removed / float(times[-1]) if times[-1] > 0 else float("nan"),
+    }

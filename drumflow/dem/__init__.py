@@ -7,14 +7,23 @@ LIGGGHTS restart file; a finished run is reused.
 
 from __future__ import annotations
 
+import json
 import re
+import sys
 import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from drumflow.dem.deck import DeckFiles, deck_context, plan_steps, render_deck, short_plan
+from drumflow.dem.deck import (
+    DeckFiles,
+    deck_context,
+    end_commands,
+    plan_steps,
+    render_deck,
+    short_plan,
+)
 from drumflow.dem.placement import place_particles, write_data_file
 from drumflow.dem.thermo import ThermoParser
 from drumflow.dem.timestep import choose_time_step
@@ -27,12 +36,39 @@ if TYPE_CHECKING:
     from drumflow.rundir import RunDir
     from drumflow.runner import Runner
 
-__all__ = ["DemResult", "ThermoParser", "run_dem", "dem_key"]
+__all__ = ["AirCoupling", "DemResult", "ThermoParser", "run_dem", "dem_key"]
 
 #: progress(stage, done, total): simulated seconds done out of the total.
 ProgressCallback = Callable[[str, float, float], None]
 
 _LOST_RE = re.compile(r"Lost atoms")
+
+
+@dataclass(frozen=True)
+class AirCoupling:
+    """How the air acts on the particles during the DEM run (one-way).
+
+    Attributes
+    ----------
+    field
+        The driver's field spec: ``{"kind": "uniform", "velocity": [ux, uy, uz]}`` or
+        ``{"kind": "grid", "path": "/abs/path/field.npz"}``.
+    field_key
+        Identifies the field (its hash), for the stage key.
+    interval
+        DEM steps between air updates.
+    temperature_C, pressure_kPa
+        The air's state (one-way: the air keeps its inlet temperature).
+    omega
+        Rotation rate of the frame the field was solved in (0 for a uniform field), rad/s.
+    """
+
+    field: dict
+    field_key: str
+    interval: int
+    temperature_C: float
+    pressure_kPa: float
+    omega: float
 
 
 @dataclass(frozen=True)
@@ -73,6 +109,7 @@ def run_dem(
     steps: int | None = None,
     timeout: float | None = None,
     extra_commands: str = "",
+    air: AirCoupling | None = None,
 ) -> DemResult:
     """Run (or resume, or reuse) the DEM stage.
 
@@ -85,6 +122,9 @@ def run_dem(
     extra_commands
         LIGGGHTS lines run just before the main run (verification and stress scenes); they
         are part of the stage key.
+    air
+        Air acting on the particles; the run then goes through the coupling loop
+        (:mod:`drumflow.coupling.driver`) instead of plain LIGGGHTS.
 
     Raises
     ------
@@ -94,6 +134,8 @@ def run_dem(
         LIGGGHTS failed otherwise.
     """
     key = dem_key(case, steps) + (f":extra={hash_text(extra_commands)}" if extra_commands else "")
+    if air is not None:
+        key += f":air={air.field_key}:every={air.interval}"
     done = rundir.stage_done("dem", key)
     if done:
         return DemResult(**done["result"])
@@ -111,7 +153,9 @@ def run_dem(
     if resume is None:
         for old in (work / "dumps").glob("*.txt"):
             old.unlink()
-        for old in [*(work / "restart").glob("*.restart"), *work.glob("log.resume-*.liggghts")]:
+        stale = [*(work / "restart").glob("*.restart"), *work.glob("log.resume-*.liggghts"),
+                 *(work / "coupling").glob("*.csv")]
+        for old in stale:
             old.unlink()
         positions = place_particles(case, n)
         write_data_file(case, positions, work / "particles.data", (geometry.box_lo, geometry.box_hi))
@@ -123,10 +167,12 @@ def run_dem(
         files,
         resume_from=None if resume is None else str(resume[0].relative_to(work)),
         extra_commands=extra_commands,
+        coupled=air is not None,
     )
     deck_name = "in.drum" if resume is None else "in.drum.resume"
     (work / deck_name).write_text(render_deck(context))
     rundir.record("time_step", choice.as_dict())
+    rundir.record("output_every", plan.dump_every)
 
     total = plan.steps * plan.time_step
     parser = ThermoParser(
@@ -148,9 +194,25 @@ def run_dem(
             return "LIGGGHTS stopped before finishing its run loop"
         return None
 
-    command = runner.profile.mpi_command(
-        ["liggghts", "-in", deck_name, "-log", own_log.name], case.run.processes
-    )
+    if air is None:
+        program = ["liggghts", "-in", deck_name, "-log", own_log.name]
+    else:
+        spec = {
+            "deck": deck_name,
+            "log": own_log.name,
+            "total_steps": plan.steps,
+            "interval": air.interval,
+            "time_step": plan.time_step,
+            "omega": air.omega,
+            "air_temperature_C": air.temperature_C,
+            "air_pressure_kPa": air.pressure_kPa,
+            "field": air.field,
+            "coupling_log": "coupling/rank{rank}.{start}.csv",
+            "tail": end_commands(context),
+        }
+        (work / "coupling.json").write_text(json.dumps(spec, indent=2))
+        program = [sys.executable, "-m", "drumflow.coupling.driver", "coupling.json"]
+    command = runner.profile.mpi_command(program, case.run.processes)
     t0 = time.perf_counter()
     try:
         runner.run(

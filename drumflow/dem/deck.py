@@ -128,6 +128,7 @@ def deck_context(
     files: DeckFiles = DeckFiles(),
     resume_from: str | None = None,
     extra_commands: str = "",
+    coupled: bool = False,
 ) -> dict[str, Any]:
     """All values the template needs.
 
@@ -174,9 +175,16 @@ def deck_context(
         "final_restart": files.final_restart,
         "steps": plan.steps,
         "extra_commands": extra_commands,
+        "coupled": coupled,
     }
 
 
 def render_deck(context: dict[str, Any], template: str = "drum.in.j2") -> str:
     """Render a deck template with :class:`jinja2.StrictUndefined` (missing values raise)."""
     return _environment().get_template(template).render(**context)
+
+
+def end_commands(context: dict[str, Any]) -> list[str]:
+    """The deck's closing commands (final snapshot, restart) for the coupling loop to issue."""
+    text = render_deck(context, "drum_end.in.j2")
+    return [ln for ln in text.splitlines() if ln.strip() and not ln.lstrip().startswith("#")]

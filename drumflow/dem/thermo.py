@@ -55,8 +55,12 @@ def log_files(dem_dir: Path) -> list[Path]:
     return logs
 
 
-def read_thermo(dem_dir: Path) -> pd.DataFrame:
+def read_thermo(dem_dir: Path, every: int | None = None) -> pd.DataFrame:
     """The thermo series of a DEM stage, one row per output step, later attempts winning.
+
+    ``every``: keep only steps that are multiples of it (and the last step). The coupling loop
+    runs LIGGGHTS in short runs, each printing thermo at its first and last step; the output
+    grid is the multiples of the output step.
 
     Returns
     -------
@@ -86,5 +90,8 @@ def read_thermo(dem_dir: Path) -> pd.DataFrame:
     # `run 0` at the very end repeats the last step: keep one row per step.
     table = table.sort_values(["step", "attempt"]).drop_duplicates("step", keep="last")
     table["step"] = table["step"].astype(np.int64)
+    if every:
+        last = table["step"].max()
+        table = table[(table["step"] % every == 0) | (table["step"] == last)]
     table["atoms"] = table["atoms"].astype(np.int64)
     return table.drop(columns="attempt").reset_index(drop=True)

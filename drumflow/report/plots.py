@@ -91,3 +91,21 @@ def plot_particles(x: NDArray, y: NDArray, T: NDArray, case: Case, path: Path, t
     fig.tight_layout()
     fig.savefig(path)
     plt.close(fig)
+
+
+def plot_air_heat(coupling: pd.DataFrame, path: Path, title: str) -> None:
+    """Heat removed by the air: rate (W) and cumulative (J) against time."""
+    plt = _plt()
+    fig, ax = plt.subplots(figsize=(6, 3.6), dpi=120)
+    t = coupling["time_s"].to_numpy()
+    ax.plot(t, -coupling["heat_to_particles_W"].to_numpy(), color="tab:blue", lw=1.2)
+    ax.set_xlabel("time (s)")
+    ax.set_ylabel("heat removal rate (W)", color="tab:blue")
+    ax2 = ax.twinx()
+    ax2.plot(t, coupling["heat_removed_J"].to_numpy(), color="tab:red", lw=1.6)
+    ax2.set_ylabel("heat removed (J)", color="tab:red")
+    ax.set_title(title, fontsize=9)
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)

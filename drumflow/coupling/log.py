@@ -1,0 +1,55 @@
+"""The coupling loop's logs: heat and drag the air applied, summed over MPI ranks and attempts."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+_NAME = re.compile(r"rank(\d+)\.(\d+)\.csv$")
+
+
+def read_coupling(folder: Path, time_step: float) -> pd.DataFrame:
+    """One row per coupling update: step, time, steps held, heat (W) and drag (N) on all particles.
+
+    Each rank logs its own particles (``rank<R>.<start step>.csv``); a resumed attempt supersedes
+    what earlier attempts logged from its start step on.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns ``step, time_s, steps, heat_to_particles_W, drag_x_N, drag_y_N, drag_z_N,
+        particles, heat_removed_J`` (cumulative heat taken from the particles), sorted by step;
+        empty when the run had no air.
+    """
+    attempts: dict[int, list[pd.DataFrame]] = {}
+    for path in folder.glob("rank*.csv"):
+        m = _NAME.search(path.name)
+        if not m:
+            continue
+        frame = pd.read_csv(path)
+        if not frame.empty:
+            attempts.setdefault(int(m.group(2)), []).append(frame)
+    if not attempts:
+        return pd.DataFrame()
+    starts = sorted(attempts)
+    kept = []
+    for i, start in enumerate(starts):
+        frame = pd.concat(attempts[start], ignore_index=True)
+        summed = frame.groupby("step", as_index=False).agg(
+            steps=("steps", "first"),
+            heat_to_particles_W=("heat_to_particles_W", "sum"),
+            drag_x_N=("drag_x_N", "sum"),
+            drag_y_N=("drag_y_N", "sum"),
+            drag_z_N=("drag_z_N", "sum"),
+            particles=("particles", "sum"),
+        )
+        end = starts[i + 1] if i + 1 < len(starts) else np.inf
+        kept.append(summed[summed["step"] < end])
+    table = pd.concat(kept, ignore_index=True).sort_values("step").reset_index(drop=True)
+    table.insert(1, "time_s", table["step"] * time_step)
+    # The heat is held constant over `steps` DEM steps: LIGGGHTS adds it at each of them.
+    table["heat_removed_J"] = np.cumsum(-table["heat_to_particles_W"] * table["steps"] * time_step)
+    return table
