@@ -362,6 +362,35 @@ def methodology(
     console.print(f"per-step table: {csv_path}", highlight=False)
 
 
+@app.command()
+def verify(
+    quick: Annotated[bool, typer.Option("--quick", help="only what fits in a couple of minutes")] = False,
+    out: Annotated[Path, typer.Option("--out", "-o", help="where the cases and verification.json go")] = Path("runs/verify"),
+) -> None:
+    """Run the verification cases (analytic solutions, conservation laws) on the real solvers."""
+    from drumflow.verify import run_verification
+
+    table = Table(title="drumflow verify" + (" --quick" if quick else ""))
+    for col in ("check", "measured", "expected", "error", "tolerance", ""):
+        table.add_column(col, justify="right" if col not in ("check", "") else "left")
+
+    def show(c) -> None:  # type: ignore[no-untyped-def]
+        mark = "[green]pass[/]" if c.passed else "[bold red]FAIL[/]"
+        err_console.print(f"{mark} {c.name}: error {c.error:.3g} (tolerance {c.tolerance:.3g})", highlight=False)
+        table.add_row(c.name, f"{c.measured:.6g} {c.unit}", f"{c.expected:.6g}", f"{c.error:.3g}",
+                      f"{c.tolerance:.3g}", mark)
+
+    try:
+        checks = run_verification(out, quick=quick, on_check=show)
+    except DrumflowError as exc:
+        _fail(exc, 1)
+        return
+    console.print(table)
+    console.print(f"written: {out / 'verification.json'}", highlight=False)
+    if not all(c.passed for c in checks):
+        raise typer.Exit(1)
+
+
 def main() -> None:
     """Console-script entry point."""
     try:

@@ -22,15 +22,6 @@ def smoke_dict() -> dict[str, Any]:
 
 def tiny_case_dict(**overrides: Any) -> dict[str, Any]:
     """A very small drum for real-solver tests: 0.2 m, 6 lifters, 500 particles of 8 mm."""
-    with (CASES / "smoke.toml").open("rb") as fh:
-        d = tomllib.load(fh)
-    d["name"] = "tiny"
-    d["drum"].update(diameter=0.2, length=0.048, rpm=30.0)
-    d["lifters"].update(count=6, base_height=0.025, lip_length=0.012, thickness=0.003)
-    d["particles"].update(count=500)
-    d["run"].update(time=1.2, dump_interval=0.01, snapshot_interval=0.1, mass_flow_start=0.6,
-                    restart_interval=0.2)
-    for key, value in overrides.items():
-        section, field = key.split("__")
-        d[section][field] = value
-    return d
+    from drumflow.verify.scenes import tiny_drum_dict
+
+    return tiny_drum_dict(**overrides)

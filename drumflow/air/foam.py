@@ -25,8 +25,8 @@ could not pass. Their normals are along the axis, so omega x r adds no flux ther
 
 Numerics: ``Gauss linear`` gradients (on a 53k-cell lifter drum they reached 1e-4 in 54 SIMPLE
 iterations where ``cellLimited`` stalled near 1e-3), bounded ``linearUpwind`` for U, bounded
-``limitedLinear`` for k and epsilon, SIMPLE with ``residualControl`` at
-``air.residual_target``. All dictionaries are written with foamlib.
+``upwind`` for k and epsilon (second-order schemes there stalled, see
+:func:`write_fv_schemes`), SIMPLEC with ``residualControl`` at ``air.residual_target``. All dictionaries are written with foamlib.
 """
 
 from __future__ import annotations
@@ -291,7 +291,6 @@ def write_control_dict(
         f["purgeWrite"] = 0
         f["writeFormat"] = "ascii"
         f["writePrecision"] = 10
-        f["writeCompression"] = "off"
         f["timeFormat"] = "general"
         f["timePrecision"] = 8
         f["runTimeModifiable"] = False
@@ -310,8 +309,11 @@ def write_fv_schemes(case_dir: Path) -> None:
         f["divSchemes"] = {
             "default": "none",
             "div(phi,U)": ("bounded", "Gauss", "linearUpwind", "grad(U)"),
-            "div(phi,k)": ("bounded", "Gauss", "limitedLinear", 1),
-            "div(phi,epsilon)": ("bounded", "Gauss", "limitedLinear", 1),
+            # First order for k and epsilon: on coarse tetrahedra at the thin lifters,
+            # limitedLinear and linearUpwind left epsilon bounded below zero every iteration
+            # and its residual stalled at 4e-3 to 1e-2; upwind converges monotonically.
+            "div(phi,k)": ("bounded", "Gauss", "upwind"),
+            "div(phi,epsilon)": ("bounded", "Gauss", "upwind"),
             "div((nuEff*dev2(T(grad(U)))))": ("Gauss", "linear"),
         }
         # Tetrahedra are far from orthogonal at the lifter edges: limit the explicit
@@ -596,6 +598,43 @@ def read_cell_fields(case_dir: Path, time_dir: str) -> dict[str, NDArray[np.floa
     return out
 
 
+def read_boundary_values(
+    case_dir: Path, time_dir: str, omega: float, moving_walls: tuple[str, ...] = ("walls",)
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Boundary face centres (m, 3) and their absolute air velocity (m, 3).
+
+    Patches that store a ``value`` for U (inlet, outlet) give it; ``noSlip`` patches named in
+    ``moving_walls`` turn with the MRF zone, so their absolute velocity is omega e_z x r (MRF
+    sets it at every iteration but ``noSlip`` does not write it). Added to the cell centres,
+    these points let the grid resampling interpolate right up to the walls and end faces.
+    """
+    from foamlib import FoamFieldFile
+
+    t = case_dir / time_dir
+    centres = FoamFieldFile(t / "C").boundary_field
+    velocity = FoamFieldFile(t / "U").boundary_field
+    pts: list[NDArray[np.float64]] = []
+    vel: list[NDArray[np.float64]] = []
+    for name, entry in centres.items():
+        if "value" not in entry:
+            continue  # empty patches have no faces in a 3D sense
+        c = np.asarray(entry["value"], dtype=float).reshape(-1, 3)
+        u_entry = velocity.get(name, {})
+        if name in moving_walls:
+            u = np.column_stack([-omega * c[:, 1], omega * c[:, 0], np.zeros(len(c))])
+        elif "value" in u_entry:
+            u = np.broadcast_to(np.asarray(u_entry["value"], dtype=float), c.shape).copy()
+        elif u_entry.get("type") == "noSlip":
+            u = np.zeros_like(c)
+        else:
+            continue
+        pts.append(c)
+        vel.append(u.reshape(-1, 3))
+    if not pts:
+        return np.zeros((0, 3)), np.zeros((0, 3))
+    return np.concatenate(pts), np.concatenate(vel)
+
+
 def patch_flux(case_dir: Path, time_dir: str, patch: str) -> float:
     """Sum of the face fluxes ``phi`` (m^3/s, positive out of the domain) over a patch."""
     from foamlib import FoamFieldFile
@@ -744,6 +783,10 @@ def solve_air(
         )
         solver_wall = time.time() - solver_started
         run_foam(runner, "reconstructPar", ["-latestTime"], workdir, timeout=timeout)
+        # The reconstructed case holds everything; the per-rank copies would only double
+        # the disk use and confuse a later serial run of the same directory.
+        for p in workdir.glob("processor*"):
+            shutil.rmtree(p)
     else:
         log = run_foam(runner, "simpleFoam", [], workdir, timeout=timeout, on_line=parser)
         solver_wall = time.time() - solver_started

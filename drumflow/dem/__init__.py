@@ -9,13 +9,13 @@ from __future__ import annotations
 
 import json
 import re
-import sys
 import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from drumflow.coupling import driver_command
 from drumflow.dem.deck import (
     DeckFiles,
     deck_context,
@@ -194,9 +194,8 @@ def run_dem(
             return "LIGGGHTS stopped before finishing its run loop"
         return None
 
-    if air is None:
-        program = ["liggghts", "-in", deck_name, "-log", own_log.name]
-    else:
+    program = ["liggghts", "-in", deck_name, "-log", own_log.name]
+    if air is not None:
         spec = {
             "deck": deck_name,
             "log": own_log.name,
@@ -211,8 +210,10 @@ def run_dem(
             "tail": end_commands(context),
         }
         (work / "coupling.json").write_text(json.dumps(spec, indent=2))
-        program = [sys.executable, "-m", "drumflow.coupling.driver", "coupling.json"]
-    command = runner.profile.mpi_command(program, case.run.processes)
+    if air is None:
+        command = runner.profile.mpi_command(program, case.run.processes)
+    else:
+        command = driver_command(runner.profile, case.run.processes)
     t0 = time.perf_counter()
     try:
         runner.run(

@@ -21,15 +21,18 @@ COLUMNS = ("step", "time", "atoms", "ke", "ke_rot", "T_mean", "cpu")
 class ThermoParser:
     """Collects thermo rows from lines as they come; optionally reports simulated time."""
 
-    columns = COLUMNS
-
-    def __init__(self, on_time: Callable[[float, int], None] | None = None) -> None:
+    def __init__(
+        self,
+        on_time: Callable[[float, int], None] | None = None,
+        columns: tuple[str, ...] = COLUMNS,
+    ) -> None:
         self.rows: list[tuple[float, ...]] = []
         self.on_time = on_time
+        self.columns = columns
 
     def __call__(self, line: str) -> None:
         parts = line.split()
-        if len(parts) != len(COLUMNS) or not parts[0].isdigit():
+        if len(parts) != len(self.columns) or not parts[0].isdigit():
             return
         try:
             row = tuple(float(p) for p in parts)

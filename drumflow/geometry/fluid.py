@@ -162,6 +162,9 @@ def write_fluid_mesh(case: Case, path: Path, size: float | None = None) -> dict[
         gmsh.option.setNumber("Mesh.Algorithm", 6)  # Frontal-Delaunay surfaces
         gmsh.option.setNumber("Mesh.Algorithm3D", 1)  # Delaunay volumes: robust and fast
         gmsh.option.setNumber("Mesh.Optimize", 1)  # remove slivers (checkMesh skewness)
+        # Netgen's optimiser halves the worst skewness and aspect ratio next to the lifters
+        # (on the 0.4 m smoke drum at 0.03 m: skewness 2.0 -> 1.2, aspect ratio 17 -> 9).
+        gmsh.option.setNumber("Mesh.OptimizeNetgen", 1)
         gmsh.option.setNumber("Mesh.MshFileVersion", 2.2)
         gmsh.option.setNumber("Mesh.Binary", 0)  # gmshToFoam reads ASCII only
         gmsh.option.setNumber("Mesh.SaveAll", 0)  # only the physical groups

@@ -152,15 +152,15 @@ def test_cli_check_good_case() -> None:
     assert "valid" in out.stdout
 
 
-def test_cli_check_refuses_air_model_not_built_yet(tmp_path: Path, smoke_dict: dict) -> None:
+def test_cli_check_refuses_what_is_not_built_yet(tmp_path: Path, smoke_dict: dict) -> None:
     import tomli_w
 
-    smoke_dict["air"]["model"] = "cfd"
-    path = tmp_path / "cfd.toml"
+    smoke_dict["air"]["pressure_gradient_force"] = True
+    path = tmp_path / "pgf.toml"
     path.write_text(tomli_w.dumps(smoke_dict))
     out = subprocess.run(
         [sys.executable, "-m", "drumflow.cli", "check", str(path)],
         capture_output=True, text=True, timeout=120,
     )
     assert out.returncode == 2
-    assert "air.model = 'cfd'" in out.stderr and "allowed: 'none'" in out.stderr
+    assert "air.pressure_gradient_force = true" in out.stderr and "allowed: false" in out.stderr
