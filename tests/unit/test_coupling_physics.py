@@ -1,0 +1,117 @@
+"""Drag and convection laws, rotation of the air field, and the coupling log, without a solver."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from drumflow.coupling.driver import UniformAir, air_velocity_at, rotate_z
+from drumflow.coupling.log import read_coupling
+from drumflow.coupling.physics import (
+    AirState,
+    auto_coupling_interval,
+    convective_heat,
+    drag_force,
+    lumped_temperature,
+    ranz_marshall_h,
+    schiller_naumann_cd,
+    terminal_velocity,
+)
+
+AIR = AirState.at(30.0)
+
+
+def test_air_state_ideal_gas() -> None:
+    # 101.325 kPa / (287.05 J/kg K * 303.15 K) = 1.1644 kg/m3
+    assert AIR.density == pytest.approx(101325 / (287.05 * 303.15), rel=1e-12)
+    assert 1.8e-5 < AIR.viscosity < 1.9e-5 and 0.70 < AIR.prandtl < 0.71
+
+
+def test_schiller_naumann_limits() -> None:
+    assert schiller_naumann_cd(0.1) == pytest.approx(240 * (1 + 0.15 * 0.1**0.687))
+    assert schiller_naumann_cd(5000.0) == 0.44
+    # The two branches meet within 0.5% at Re = 1000 (0.4385 against 0.44).
+    assert schiller_naumann_cd(999.999) == pytest.approx(0.44, rel=5e-3)
+
+
+def test_drag_force_equals_half_cd_rho_a_v2() -> None:
+    d = 0.008
+    for speed in (0.01, 1.0, 3.0, 20.0):
+        f = drag_force(np.array([[0.0, 0.0, speed]]), np.zeros((1, 3)), d, AIR)[0]
+        re = AIR.density * speed * d / AIR.viscosity
+        expected = 0.5 * schiller_naumann_cd(re) * AIR.density * math.pi / 4 * d**2 * speed**2
+        assert f[2] == pytest.approx(expected, rel=1e-12)
+        assert f[0] == f[1] == 0.0
+    # Zero slip: zero force, no division by zero.
+    assert np.all(drag_force(np.zeros((1, 3)), np.zeros((1, 3)), d, AIR) == 0.0)
+
+
+def test_ranz_marshall() -> None:
+    # Still air: Nu = 2 exactly, h = 2 k / d.
+    assert ranz_marshall_h(0.0, 0.008, AIR) == pytest.approx(2 * AIR.conductivity / 0.008)
+    re = AIR.density * 1.0 * 0.008 / AIR.viscosity
+    nu = 2 * (1 + 0.3 * math.sqrt(re) * AIR.prandtl ** (1 / 3))
+    assert ranz_marshall_h(1.0, 0.008, AIR) == pytest.approx(nu * AIR.conductivity / 0.008)
+
+
+def test_convective_heat_sign() -> None:
+    q = convective_heat(np.zeros((2, 3)), np.zeros((2, 3)), np.array([90.0, 30.0]), 0.008, AIR)
+    assert q[0] < 0 and q[1] == 0.0  # hot particle loses heat; one at air temperature none
+
+
+def test_lumped_and_terminal() -> None:
+    assert lumped_temperature(0.0, 90, 30, 50, 1e-3, 1000, 1e-4) == 90.0
+    tau = 1e-3 * 1000 / (50 * 1e-4)
+    assert lumped_temperature(tau, 90, 30, 50, 1e-3, 1000, 1e-4) == pytest.approx(30 + 60 / math.e)
+    v = terminal_velocity(0.008, 1050.0, AIR)
+    weight = 1050 * math.pi / 6 * 0.008**3 * 9.81
+    drag = drag_force(np.zeros((1, 3)), np.array([[0.0, 0.0, -v]]), 0.008, AIR)[0, 2]
+    assert drag == pytest.approx(weight, rel=1e-9)
+
+
+def test_auto_interval_keeps_hold_error_small() -> None:
+    dt = 1e-4
+    n = auto_coupling_interval(dt, 0.008, 1050.0, 1465.38, AIR, max_slip=6.0, cap=10_000)
+    h = float(ranz_marshall_h(6.0, 0.008, AIR))
+    tau = 1050 * math.pi / 6 * 0.008**3 * 1465.38 / (h * math.pi * 0.008**2)
+    assert n * dt <= 0.002 * tau + dt and n >= 1
+    assert auto_coupling_interval(dt, 0.008, 1050.0, 1465.38, AIR, 6.0, cap=5) == 5
+
+
+def test_rotation_round_trip_and_uniform_field() -> None:
+    x = np.random.default_rng(1).normal(size=(10, 3))
+    assert np.allclose(rotate_z(rotate_z(x, 0.7), -0.7), x)
+    assert np.allclose(rotate_z(np.array([[1.0, 0.0, 2.0]]), math.pi / 2), [[0.0, 1.0, 2.0]])
+    field = UniformAir((0.0, 0.0, -3.0))
+    assert np.allclose(air_velocity_at(field, x, 1.3, 0.5), [0.0, 0.0, -3.0])
+
+
+class _SwirlField:
+    """A field that turns with the drum: u = (-y, x, 0) in the drum frame (solid rotation)."""
+
+    def sample(self, points: np.ndarray) -> np.ndarray:
+        return np.column_stack([-points[:, 1], points[:, 0], np.zeros(len(points))])
+
+
+def test_rotating_field_is_sampled_in_the_drum_frame() -> None:
+    # Solid-body rotation looks the same in every frame orientation: the lab value at a lab
+    # point must equal (-y, x, 0) of that lab point, whatever the drum's angle.
+    x = np.array([[0.3, 0.1, 0.0], [-0.2, 0.4, 1.0]])
+    u = air_velocity_at(_SwirlField(), x, time_s=2.0, omega=0.9)
+    assert np.allclose(u, np.column_stack([-x[:, 1], x[:, 0], np.zeros(2)]))
+
+
+def test_coupling_log_sums_ranks_and_supersedes_attempts(tmp_path: Path) -> None:
+    head = "step,time_s,steps,heat_to_particles_W,drag_x_N,drag_y_N,drag_z_N,particles,mean_slip_m_s\n"
+    (tmp_path / "rank0.0.csv").write_text(head + "0,0,10,-1,0,0,0,5,1\n10,0.1,10,-1,0,0,0,5,1\n20,0.2,10,-1,0,0,0,5,1\n")
+    (tmp_path / "rank1.0.csv").write_text(head + "0,0,10,-2,0,0,0,5,1\n10,0.1,10,-2,0,0,0,5,1\n20,0.2,10,-2,0,0,0,5,1\n")
+    (tmp_path / "rank0.20.csv").write_text(head + "20,0.2,10,-4,0,0,0,10,1\n")
+    table = read_coupling(tmp_path, time_step=0.01)
+    assert table["step"].tolist() == [0, 10, 20]
+    assert table["heat_to_particles_W"].tolist() == [-3.0, -3.0, -4.0]
+    # Each row's heat is applied for 10 steps of 0.01 s: 0.3 + 0.3 + 0.4 J.
+    assert table["heat_removed_J"].iloc[-1] == pytest.approx(1.0)
+    assert read_coupling(tmp_path / "none", 0.01).empty
