@@ -93,7 +93,7 @@ def run_case(
     if progress:
         progress("geometry", 1.0, 1.0)
     plan = plan_steps(case, choose_time_step(case))
-    air = prepare_air(case, rundir, runner, plan.time_step, plan.dump_every)
+    air = prepare_air(case, rundir, runner, plan.time_step, plan.dump_every, progress)
     if air is not None:
         rundir.record("air", asdict(air[1]))
         if progress:

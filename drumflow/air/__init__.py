@@ -22,6 +22,7 @@ import shutil
 import time
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
+from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
 from drumflow.coupling.physics import AirState, auto_coupling_interval
@@ -66,7 +67,12 @@ class AirSummary:
 
 
 def prepare_air(
-    case: Case, rundir: RunDir, runner: Runner, time_step: float, dump_every: int
+    case: Case,
+    rundir: RunDir,
+    runner: Runner,
+    time_step: float,
+    dump_every: int,
+    progress: Callable[[str, float, float], None] | None = None,
 ) -> tuple[AirCoupling, AirSummary] | None:
     """Build (or fetch from cache) the air field and the coupling settings for the DEM run.
 
@@ -99,11 +105,16 @@ def prepare_air(
         summary = AirSummary("uniform", state.density, u_mean, case.air.mass_flow,
                              case.air.mass_flow, interval)
         return coupling, summary
-    return _prepare_cfd(case, rundir, runner, state, interval)
+    return _prepare_cfd(case, rundir, runner, state, interval, progress)
 
 
 def _prepare_cfd(
-    case: Case, rundir: RunDir, runner: Runner, state: AirState, interval: int
+    case: Case,
+    rundir: RunDir,
+    runner: Runner,
+    state: AirState,
+    interval: int,
+    progress: Callable[[str, float, float], None] | None,
 ) -> tuple[AirCoupling, AirSummary]:
     from drumflow.air.field import AirField, air_cache_key, plot_air_cross_section
     from drumflow.air.foam import solve_air
@@ -118,7 +129,14 @@ def _prepare_cfd(
         work = rundir.root / "air" / "openfoam"
         if work.exists():
             shutil.rmtree(work)
-        solution = solve_air(case, work, runner)
+        total = float(case.air.max_iterations)
+
+        def on_iteration(iteration: int, *_: object) -> None:
+            if progress:
+                progress("air (OpenFOAM)", min(float(iteration), total), total)
+
+        solution = solve_air(case, work, runner, processes=case.run.processes,
+                             on_iteration=on_iteration)
         field_ = AirField.from_solution(solution, case)
         cache.mkdir(parents=True, exist_ok=True)
         field_.to_npz(cached)

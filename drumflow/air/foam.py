@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import math
 import re
+import shutil
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -43,7 +44,7 @@ import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
-from drumflow.air.mesh import build_air_mesh, openfoam_env, run_foam
+from drumflow.air.mesh import build_air_mesh, foam_check, openfoam_env, run_foam
 from drumflow.errors import SolverError
 from drumflow.runner import Runner
 
@@ -130,12 +131,16 @@ class ResidualParser:
         self._on_iteration = on_iteration
 
     def _flush(self) -> None:
-        if self._current is not None and len(self._current) > 1:
-            self.rows.append(self._current)
+        row, self._current = self._current, None
+        if row is not None and len(row) > 1:
+            self.rows.append(row)
             if self._on_iteration is not None:
-                it = int(self._current["iteration"])
-                self._on_iteration(it, {k: v for k, v in self._current.items() if k != "iteration"})
-        self._current = None
+                try:
+                    self._on_iteration(
+                        int(row["iteration"]), {k: v for k, v in row.items() if k != "iteration"}
+                    )
+                except Exception:  # a progress display must never spoil the residual history
+                    pass
 
     def __call__(self, line: str) -> None:
         m = _TIME_RE.match(line)
@@ -589,35 +594,45 @@ def read_cell_fields(case_dir: Path, time_dir: str) -> dict[str, NDArray[np.floa
     t = case_dir / time_dir
     C = _internal(t / "C").reshape(-1, 3)
     n = len(C)
-    out = {"C": C}
-    for name, width in (("V", 1), ("U", 3), ("p", 1)):
-        arr = _internal(t / name)
+    out: dict[str, NDArray[np.float64]] = {"C": C}
+    for name, shape in (("V", (n,)), ("U", (n, 3)), ("p", (n,))):
         # A uniform field comes back as one value: spread it over the cells.
-        arr = np.broadcast_to(arr, (n, width) if width > 1 else (n,)).copy()
-        out[name] = arr.reshape(n, width) if width > 1 else arr.reshape(n)
+        out[name] = np.broadcast_to(_internal(t / name), shape).copy()
     return out
 
 
 def read_boundary_values(
-    case_dir: Path, time_dir: str, omega: float, moving_walls: tuple[str, ...] = ("walls",)
+    case_dir: Path,
+    time_dir: str,
+    omega: float,
+    patches: tuple[str, ...] = ("inlet", "outlet"),
+    moving_walls: tuple[str, ...] = ("walls",),
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Boundary face centres (m, 3) and their absolute air velocity (m, 3).
+    """Boundary face centres (m, 3) of some patches and their absolute air velocity (m, 3).
 
-    Patches that store a ``value`` for U (inlet, outlet) give it; ``noSlip`` patches named in
-    ``moving_walls`` turn with the MRF zone, so their absolute velocity is omega e_z x r (MRF
-    sets it at every iteration but ``noSlip`` does not write it). Added to the cell centres,
-    these points let the grid resampling interpolate right up to the walls and end faces.
+    Patches that store a ``value`` for U (inlet, outlet) give it; a ``noSlip`` patch named in
+    ``moving_walls`` turns with the MRF zone, so its absolute velocity is omega e_z x r (MRF
+    sets it at every iteration, but ``noSlip`` does not write it); other ``noSlip`` patches
+    are at rest.
+
+    Parameters
+    ----------
+    patches
+        The patches to read. The default, the end faces only, is what the grid resampling
+        uses: see :meth:`drumflow.air.field.AirField.from_solution` for why walls are left out.
     """
     from foamlib import FoamFieldFile
 
     t = case_dir / time_dir
-    centres = FoamFieldFile(t / "C").boundary_field
-    velocity = FoamFieldFile(t / "U").boundary_field
+    # foamlib's value types are wide unions; these are dictionaries of patch dictionaries.
+    centres: Any = FoamFieldFile(t / "C").boundary_field
+    velocity: Any = FoamFieldFile(t / "U").boundary_field
     pts: list[NDArray[np.float64]] = []
     vel: list[NDArray[np.float64]] = []
-    for name, entry in centres.items():
-        if "value" not in entry:
-            continue  # empty patches have no faces in a 3D sense
+    for name in patches:
+        entry = centres.get(name)
+        if entry is None or "value" not in entry:
+            continue  # no such patch, or an empty one
         c = np.asarray(entry["value"], dtype=float).reshape(-1, 3)
         u_entry = velocity.get(name, {})
         if name in moving_walls:
@@ -639,7 +654,8 @@ def patch_flux(case_dir: Path, time_dir: str, patch: str) -> float:
     """Sum of the face fluxes ``phi`` (m^3/s, positive out of the domain) over a patch."""
     from foamlib import FoamFieldFile
 
-    value = FoamFieldFile(case_dir / time_dir / "phi").boundary_field[patch]["value"]
+    boundary: Any = FoamFieldFile(case_dir / time_dir / "phi").boundary_field
+    value = boundary[patch]["value"]
     return float(np.sum(np.asarray(value, dtype=float)))
 
 
@@ -753,8 +769,6 @@ def solve_air(
     drumflow.errors.SolverError
         When any OpenFOAM program fails (its log is named in the message).
     """
-    import shutil
-
     runner = runner or Runner()
     started = time.time()
     workdir = Path(workdir)
@@ -780,6 +794,7 @@ def solve_air(
             timeout=timeout,
             on_line=parser,
             env=openfoam_env(),
+            check=foam_check,
         )
         solver_wall = time.time() - solver_started
         run_foam(runner, "reconstructPar", ["-latestTime"], workdir, timeout=timeout)

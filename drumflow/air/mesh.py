@@ -15,7 +15,7 @@ import os
 import re
 from collections.abc import Mapping
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, cast
 
 from drumflow.errors import SolverError
 from drumflow.runner import Runner
@@ -119,8 +119,10 @@ def set_patch_types(case_dir: Path, types: Mapping[str, str]) -> dict[str, str]:
     from foamlib import FoamFile
 
     boundary = FoamFile(case_dir / "constant" / "polyMesh" / "boundary")
-    patches = boundary[None]
-    assert isinstance(patches, list)
+    # The boundary file is one list of (name, dictionary) pairs; foamlib types it as a union.
+    patches = cast(list[tuple[str, dict[str, Any]]], boundary[None])
+    if not isinstance(patches, list):
+        raise SolverError("gmshToFoam", [], None, None, reason="unreadable polyMesh/boundary")
     names = {name for name, _ in patches}
     missing = sorted(set(types) - names)
     if missing:
