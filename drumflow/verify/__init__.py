@@ -62,6 +62,43 @@ def energy_balance(work: Path) -> Check:
     )
 
 
+def air_field_checks(work: Path, runner: Runner) -> list[Check]:
+    """OpenFOAM on the tiny drum: mass flow in = out, and the bulk axial velocity."""
+    from drumflow.air.foam import solve_air
+
+    t0 = time.perf_counter()
+    case = tiny_drum(air__model="cfd", air__mass_flow=0.1, air__mesh_size=0.02)
+    sol = solve_air(case, work, runner)
+    wall = time.perf_counter() - t0
+    note = f"tiny drum, {sol.mesh.get('cells')} cells, {sol.iterations} SIMPLE iterations"
+    return [
+        Check(name="air_mass_flow_in_equals_out", measured=sol.outlet_mass_flow,
+              expected=sol.inlet_mass_flow,
+              error=relative_error(sol.outlet_mass_flow, sol.inlet_mass_flow), tolerance=0.005,
+              unit="kg/s", note=note, wall_time_s=wall),
+        Check(name="air_mean_axial_velocity", measured=sol.mean_axial_velocity,
+              expected=sol.expected_axial_velocity,
+              error=relative_error(sol.mean_axial_velocity, sol.expected_axial_velocity),
+              tolerance=0.01, unit="m/s",
+              note="volume-mean axial velocity through the free cross-section against "
+                   "mdot / (rho A_free); " + note, wall_time_s=wall),
+    ]
+
+
+def couette_check(work: Path, runner: Runner) -> Check:
+    """Laminar flow between rotating cylinders: u_theta = A r + B / r."""
+    from drumflow.air.verify_couette import verify_couette
+
+    t0 = time.perf_counter()
+    result = verify_couette(work, runner)
+    return Check(
+        name="couette_rotating_cylinders", measured=result.max_relative_error, expected=0.0,
+        error=result.max_relative_error, tolerance=0.02, unit="of inner wall speed",
+        note=f"{result.method}, {result.cells} cells, largest |u - u_exact| over all cells",
+        wall_time_s=time.perf_counter() - t0,
+    )
+
+
 def coupling_interval_sweep(work: Path, runner: Runner) -> list[Check]:
     """Heat removed from a particle in 1 m/s air over one time constant, against N = 1."""
     from drumflow.coupling.physics import AirState, auto_coupling_interval
@@ -97,6 +134,8 @@ def run_verification(
         lambda: [terminal_settling(out / "terminal_velocity", runner)],
         lambda: [conduction_conservation(out / "conduction")],
         lambda: [energy_balance(out / "energy_balance")],
+        lambda: air_field_checks(out / "air_field", runner),
+        lambda: [couette_check(out / "couette", runner)],
     ]
     if not quick:
         steps.append(lambda: coupling_interval_sweep(out / "interval_sweep", runner))

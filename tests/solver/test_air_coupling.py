@@ -27,7 +27,9 @@ def test_verify_quick_passes_and_writes_json(tmp_path: Path) -> None:
     checks = json.loads((out / "verification.json").read_text())
     names = {c["name"] for c in checks}
     assert {"lumped_cooling_one_time_constant", "terminal_velocity_schiller_naumann",
-            "conduction_conserves_mean_temperature", "energy_balance_air_heat"} <= names
+            "conduction_conserves_mean_temperature", "energy_balance_air_heat",
+            "air_mass_flow_in_equals_out", "air_mean_axial_velocity",
+            "couette_rotating_cylinders"} <= names
     for c in checks:
         assert set(c) >= {"name", "measured", "expected", "error", "tolerance", "passed"}
         assert c["passed"], c

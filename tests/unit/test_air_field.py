@@ -80,20 +80,6 @@ def test_local_linear_fit_is_exact_for_linear_data_and_bounded() -> None:
     assert got.min() >= 0.0 and got.max() <= 1.0
 
 
-def test_sampling_reaches_a_million_samples_per_second(record_property: Any) -> None:
-    # A grid of 1.2 million nodes (far larger than the CPU caches) sampled at a million
-    # random points: the DEM coupling samples every particle every N steps, so one air
-    # update of a million particles must take under a second.
-    shape = (120, 120, 84)
-    field = AirField(
-        np.zeros(3), np.full(3, 0.01), np.random.default_rng(0).random((*shape, 3)),
-        np.zeros(shape), np.ones(shape, bool), omega=1.0,
-    )
-    rate = benchmark_sampling(field, n=1_000_000, repeats=3)
-    record_property("air_field_samples_per_s", rate)
-    assert rate > 1e6
-
-
 def test_nodes_in_lifters_and_outside_the_shell_take_the_nearest_fluid_cell(
     smoke_dict: dict[str, Any],
 ) -> None:
