@@ -93,7 +93,11 @@ def run_case(
     if progress:
         progress("geometry", 1.0, 1.0)
     plan = plan_steps(case, choose_time_step(case))
-    air = prepare_air(case, rundir, runner, plan.time_step, plan.dump_every, progress)
+    try:
+        air = prepare_air(case, rundir, runner, plan.time_step, plan.dump_every, progress)
+    finally:
+        # Every OpenFOAM program run (or failed) goes into the manifest with its timing.
+        rundir.record_commands([r.as_dict() for r in runner.records])
     if air is not None:
         rundir.record("air", asdict(air[1]))
         if progress:

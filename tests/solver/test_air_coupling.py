@@ -48,3 +48,22 @@ def test_smoke_drum_with_uniform_air_cools_and_closes_energy(tmp_path: Path) -> 
     ranks = list((tmp_path / "run" / "dem" / "coupling").glob("rank1.*.csv"))
     assert ranks, "rank 1 wrote no coupling log: the run did not use 2 ranks"
     assert summary["particles_final"] == 500
+
+
+@pytest.mark.timeout(600)
+def test_interrupted_coupled_run_resumes_with_its_heat_log(tmp_path: Path) -> None:
+    from drumflow.errors import SolverTimeoutError
+    from drumflow.pipeline import run_case
+    from drumflow.verify.scenes import tiny_drum
+
+    case = tiny_drum(air__model="uniform", air__mass_flow=0.1, run__time=2.0, run__restart_interval=0.1)
+    out = tmp_path / "run"
+    with pytest.raises(SolverTimeoutError):
+        run_case(case, out, timeout=7)
+    summary = run_case(case, out, timeout=300)
+    dem = json.loads((out / "stages" / "dem.json").read_text())["result"]
+    assert dem["resumed_from_step"]
+    # Two attempts logged heat; stitched, the energy still closes.
+    assert len(list((out / "dem" / "coupling").glob("rank0.*.csv"))) == 2
+    assert summary["energy_balance_error"] < 0.005
+    assert summary["particles_final"] == 500
