@@ -230,6 +230,12 @@ def solve_outlet_temperature(
     def residual(t_mo: float) -> float:
         return h * area * s.lmtd(t_mo) - s.c_m * (s.t_mi - t_mo)
 
+    if residual(lo) >= 0.0:
+        # Pinched: the area is so large for the air's heat capacity rate that the air leaves at
+        # the material inlet temperature. The LMTD falls only logarithmically as that end
+        # difference vanishes, so the residual is still positive 1e-12 of the span from the
+        # bound; the root lies closer than that, i.e. at the air-limited bound itself.
+        return _result(s, lo, h, area)
     # xtol far below the 0.01 deg C the paper reports; rtol at brentq's floor (4 eps).
     t_mo = float(brentq(residual, lo, hi, xtol=1e-12, rtol=4.0 * 2.220446049250313e-16))
     return _result(s, t_mo, h, area)

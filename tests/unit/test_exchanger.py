@@ -268,3 +268,20 @@ def test_bad_arguments_name_the_field(override: dict[str, float], needle: str) -
 def test_section_area_rejects_bad_lengths() -> None:
     with pytest.raises(AnalysisInputError, match="section_length_m = 0"):
         exchanger_area_from_section(0.03, cooler_length_m=19.0, section_length_m=0.0, dt_s=0.005)
+
+
+def test_pinched_exchanger_returns_the_air_limited_outlet() -> None:
+    """Regression: a huge area for little air made brentq fail ('f(a) and f(b) must have
+    different signs') and `drumflow report` crash on a real sweep of small drums."""
+    from drumflow.analysis.exchanger import solve_outlet_temperature
+
+    r = solve_outlet_temperature(
+        h_w_m2k=80.0, area_m2=50.0, material_mass_flow_kg_s=13.88889, material_cp_j_kgk=1465.38,
+        material_inlet_temperature_c=90.0, air_mass_flow_kg_s=0.05, air_cp_j_kgk=1005.0,
+        air_inlet_temperature_c=30.0,
+    )
+    # Air-limited: the air leaves at the material inlet temperature, and the material cools by
+    # exactly the air's capacity rate times 60 K.
+    c_a, c_m = 0.05 * 1005.0, 13.88889 * 1465.38
+    assert r.air_outlet_temperature_c == pytest.approx(90.0, abs=1e-6)
+    assert r.material_outlet_temperature_c == pytest.approx(90.0 - c_a / c_m * 60.0, abs=1e-6)
