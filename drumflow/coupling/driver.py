@@ -22,7 +22,6 @@ from __future__ import annotations
 
 import ctypes as C
 import json
-import math
 import os
 import sys
 from dataclasses import dataclass
@@ -53,16 +52,6 @@ class UniformAir:
         return np.broadcast_to(np.asarray(self.velocity, float), (len(points), 3))
 
 
-def rotate_z(vectors: NDArray[np.float64], angle: float) -> NDArray[np.float64]:
-    """Rotate (n, 3) vectors about the z axis by ``angle`` (rad)."""
-    c, s = math.cos(angle), math.sin(angle)
-    out = np.empty_like(vectors)
-    out[:, 0] = c * vectors[:, 0] - s * vectors[:, 1]
-    out[:, 1] = s * vectors[:, 0] + c * vectors[:, 1]
-    out[:, 2] = vectors[:, 2]
-    return out
-
-
 def air_velocity_at(field: VelocityField, x: NDArray[np.float64], time_s: float, omega: float) -> NDArray[np.float64]:
     """Air velocity at lab-frame positions at time t.
 
@@ -72,8 +61,10 @@ def air_velocity_at(field: VelocityField, x: NDArray[np.float64], time_s: float,
     """
     if omega == 0.0 or isinstance(field, UniformAir):
         return field.sample(x)
+    from drumflow.air.field import rotate_to_drum_frame, rotate_to_lab_frame
+
     angle = omega * time_s
-    return rotate_z(field.sample(rotate_z(x, -angle)), angle)
+    return rotate_to_lab_frame(field.sample(rotate_to_drum_frame(x, angle)), angle)
 
 
 def load_field(spec: dict[str, Any]) -> VelocityField:
