@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING, Any
 import jinja2
 
 from drumflow.dem.timestep import TimeStepChoice
+from drumflow.dem.conduction import liggghts_conductivity
 
 if TYPE_CHECKING:
     from drumflow.case import Case
@@ -155,7 +156,12 @@ def deck_context(
         "mu_pw": f"{cc.particle_wall.friction:.6g}",
         "mur_pp": f"{cc.particle_particle.rolling_friction:.6g}",
         "mur_pw": f"{cc.particle_wall.rolling_friction:.6g}",
-        "k_particle": f"{p.conductivity:.9g}",
+        # LIGGGHTS' conduction is sqrt(2 pi) times Eq. 24's for the same k (a pure geometric
+        # factor: sqrt of the overlap area against the Hertzian contact radius), and k enters
+        # linearly, so LIGGGHTS gets k / sqrt(2 pi). See drumflow.verify.contacts.
+        "k_particle": f"{liggghts_conductivity(p.conductivity):.9g}",
+        "E_reference_particle": f"{p.youngs_modulus:.9g}",
+        "E_reference_wall": f"{E_wall:.9g}",
         "cp_particle": f"{p.heat_capacity:.9g}",
         "dt": f"{plan.time_step:.9g}",
         "gravity": [f"{g:.9f}" for g in gravity_vector(case.drum.tilt_deg)],

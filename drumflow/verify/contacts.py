@@ -33,6 +33,7 @@ from pathlib import Path
 
 import pandas as pd
 
+from drumflow.dem.conduction import GEOMETRIC_AREA_FACTOR, liggghts_conductivity
 from drumflow.dem.deck import SOFT_PARTICLE_LIMIT, render_deck
 from drumflow.dem.thermo import ThermoParser
 from drumflow.dem.timestep import MIN_STEPS_PER_CONTACT, hertz_contact_time, rayleigh_time
@@ -53,9 +54,6 @@ RAYLEIGH_FRACTION = 0.2
 #: 2.8 m/s; particles cascading down the bed meet at around 2 m/s.
 IMPACT_SPEED = 2.0
 
-#: Factor between LIGGGHTS' conduction area term and Eq. 24 for equal spheres in the
-#: small-overlap limit: sqrt(pi a^2) / sqrt(R delta / 2) with a^2 = R delta.
-GEOMETRIC_AREA_FACTOR = math.sqrt(2.0 * math.pi)
 
 _COLUMNS = ("step", "time", "vx1", "vx2", "x1", "x2", "T1", "T2", "q1")
 
@@ -122,15 +120,6 @@ def liggghts_heat_flow(
         overlap = reference_overlap(overlap, youngs_modulus, reference_modulus)
     area = geometric_overlap_area(radius, radius, 2.0 * radius - overlap)
     return 4.0 * harmonic_conductivity(k_i, k_j) * math.sqrt(area) * (T_j - T_i)
-
-
-def liggghts_conductivity(conductivity: float) -> float:
-    """Conductivity to give LIGGGHTS so that its conduction reproduces Eq. 24, W/(m K).
-
-    k / sqrt(2 pi): removes the geometric factor between sqrt(A_overlap) and r_c (see the
-    module docstring). Exact to delta / (8 R) for equal spheres.
-    """
-    return conductivity / GEOMETRIC_AREA_FACTOR
 
 
 def default_time_step(
