@@ -131,13 +131,15 @@ def run(spec_path: Path) -> int:
             slip = float(np.linalg.norm(u - v, axis=1).mean()) if len(v) else 0.0
             row = (step, step * dt, n, float(heat.sum()), *map(float, force.sum(axis=0)), len(v), slip)
             out.write(",".join(f"{c:.12g}" for c in row) + "\n")
+            # Flush every row: an interrupted run is resumed from a restart file, and the heat
+            # applied before that restart must survive a SIGTERM (which ends Python without
+            # flushing its buffers), or the resumed energy balance misses it.
+            out.flush()
             rows.append(row)
             # `pre no`: nothing but per-atom values changed since the last run, so LIGGGHTS
             # need not rebuild neighbour lists or re-initialise the fixes (the loop's cost).
             lmp.command(f"run {n} pre no post no")
             step += n
-            if len(rows) % 50 == 0:
-                out.flush()
     for command in spec.get("tail", []):
         lmp.command(command)
     lmp.close()
