@@ -26,6 +26,7 @@ from drumflow.errors import CaseError
 BED_SOLIDS_FRACTION = 0.6
 
 Positive = Annotated[float, Field(gt=0)]
+PositiveInt = Annotated[int, Field(ge=1)]
 Fraction = Annotated[float, Field(ge=0, le=1)]
 
 
@@ -42,7 +43,7 @@ class Drum(_Section):
     length: float = Field(gt=0, le=30, description="simulated section length l along the axis, m")
     tilt_deg: float = Field(1.5, ge=0, lt=30, description="axis tilt below horizontal, degrees")
     rpm: float = Field(gt=0, le=60, description="rotation speed, revolutions per minute")
-    facet_size: float | Literal["auto"] = Field(
+    facet_size: Positive | Literal["auto"] = Field(
         "auto", description="STL facet edge length, m; 'auto' picks it from drum and particle size"
     )
 
@@ -157,7 +158,7 @@ class Air(_Section):
     inlet_temperature_C: float = Field(30.0, gt=-60, lt=500)
     pressure_kPa: float = Field(101.3, gt=10, lt=1000)
     heat_capacity: float = Field(1005.0, gt=0, description="air specific heat, J/(kg K)")
-    mesh_size: float | Literal["auto"] = Field(
+    mesh_size: Positive | Literal["auto"] = Field(
         "auto", description="fluid mesh cell size, m; 'auto' = drum diameter / 20"
     )
     turbulence: Literal["realizableKE", "laminar"] = Field(
@@ -167,7 +168,7 @@ class Air(_Section):
         1e-4, gt=0, lt=1, description="steady solver stops when all initial residuals fall below"
     )
     max_iterations: int = Field(2000, ge=10, le=100_000, description="SIMPLE iteration limit")
-    coupling_interval: int | Literal["auto"] = Field(
+    coupling_interval: PositiveInt | Literal["auto"] = Field(
         "auto", description="DEM steps between air-on-particle updates; 'auto' from the N-sweep"
     )
     pressure_gradient_force: bool = Field(
@@ -179,7 +180,7 @@ class Run(_Section):
     """How long and how finely to simulate."""
 
     time: float = Field(gt=0, le=3600, description="simulated time, s")
-    time_step: float | Literal["auto"] = Field("auto", description="DEM time step, s, or 'auto'")
+    time_step: Positive | Literal["auto"] = Field("auto", description="DEM time step, s, or 'auto'")
     rayleigh_fraction: float = Field(
         0.2, gt=0, le=0.5, description="'auto' time step as a fraction of the Rayleigh time"
     )
@@ -200,7 +201,7 @@ class Run(_Section):
     restart_interval: float = Field(
         0.5, gt=0, description="time between restart files (resume after an interrupt), s"
     )
-    neighbor_skin: float | Literal["auto"] = Field(
+    neighbor_skin: Positive | Literal["auto"] = Field(
         "auto", description="neighbour-list skin, m; 'auto' = 0.5 particle diameters"
     )
 
@@ -366,7 +367,10 @@ _BOUNDS = (("gt", ">"), ("ge", ">="), ("lt", "<"), ("le", "<="))
 def _clean_loc(err: dict[str, Any]) -> str:
     # pydantic appends the union member tag ("float", "literal['auto']") to the location.
     parts = [str(p) for p in err.get("loc", ())]
-    return ".".join(p for p in parts if p not in {"float", "int"} and not p.startswith("literal["))
+    return ".".join(
+        p for p in parts
+        if p not in {"float", "int"} and not p.startswith(("literal[", "constrained-"))
+    )
 
 
 def _merge_problems(errors: list[dict[str, Any]]) -> list[str]:
@@ -377,8 +381,12 @@ def _merge_problems(errors: list[dict[str, Any]]) -> list[str]:
     lines: list[str] = []
     for loc, errs in grouped.items():
         if len(errs) > 1 and all(e.get("type") != "value_error" for e in errs):
-            expected = " or ".join(sorted({e.get("msg", "") for e in errs}))
-            lines.append(f"{loc} = {errs[0].get('input')!r}: {expected[:1].lower()}{expected[1:]}")
+            # "must be > 0 or 'auto'": each member's own message and bounds, joined.
+            parts = []
+            for e in errs:
+                text = _format_error(e, loc)[0].split(": ", 1)[-1]
+                parts.append(text)
+            lines.append(f"{loc} = {errs[0].get('input')!r}: " + " or ".join(sorted(set(parts))))
             continue
         for err in errs:
             lines.extend(_format_error(err, loc))

@@ -164,3 +164,16 @@ def test_cli_check_refuses_what_is_not_built_yet(tmp_path: Path, smoke_dict: dic
     )
     assert out.returncode == 2
     assert "air.pressure_gradient_force = true" in out.stderr and "allowed: false" in out.stderr
+
+
+def test_numeric_or_auto_fields_reject_nonpositive(smoke_dict: dict) -> None:
+    """Regression: `float | "auto"` fields accepted negative sizes and time steps."""
+    smoke_dict["air"]["mesh_size"] = -1
+    smoke_dict["run"]["time_step"] = -1e-5
+    smoke_dict["air"]["coupling_interval"] = 0
+    smoke_dict["drum"]["facet_size"] = 0
+    problems = _problems(smoke_dict)
+    assert len(problems) == 4, problems
+    assert any(p.startswith("air.mesh_size = -1:") and "> 0" in p and "'auto'" in p for p in problems)
+    assert any(p.startswith("run.time_step = -1e-05:") for p in problems)
+    assert any(p.startswith("air.coupling_interval = 0:") and ">= 1" in p for p in problems)
