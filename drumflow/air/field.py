@@ -564,25 +564,6 @@ class AirField:
             )
 
 
-def benchmark_sampling(
-    air: AirField, n: int = 1_000_000, repeats: int = 3, seed: int = 0
-) -> float:
-    """Samples per second of :meth:`AirField.sample` on ``n`` random points in the grid.
-
-    The best of ``repeats`` timings, so that a busy machine's hiccup is not counted.
-    """
-    rng = np.random.default_rng(seed)
-    lo = air.origin
-    hi = air.origin + air.spacing * (np.array(air.shape) - 1)
-    pts = lo + rng.random((n, 3)) * (hi - lo)
-    best = math.inf
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        air.sample(pts)
-        best = min(best, time.perf_counter() - t0)
-    return n / best
-
-
 def plot_air_cross_section(
     air: AirField, case: Case, path: Path, z: float | None = None, resolution: int = 240
 ) -> None:

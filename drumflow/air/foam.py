@@ -561,6 +561,18 @@ def write_decompose_dict(case_dir: Path, processes: int, axis: int = 0) -> None:
 # -- reading results --------------------------------------------------------------------
 
 
+def write_cell_centres(runner: Runner, case_dir: Path, timeout: float | None) -> None:
+    """Write cell centres and volumes of the latest time (what :func:`read_cell_fields` reads)."""
+    run_foam(
+        runner,
+        "postProcess",
+        ["-funcs", "(writeCellCentres writeCellVolumes)", "-latestTime"],
+        case_dir,
+        timeout=timeout,
+        log_name="log.postProcess.cells",
+    )
+
+
 def latest_time(case_dir: Path) -> str:
     """Name of the latest time directory (other than 0) of a reconstructed case."""
     best: tuple[float, str] | None = None
@@ -810,14 +822,7 @@ def solve_air(
     history.to_csv(csv, index=False)
 
     time_dir = latest_time(workdir)
-    run_foam(
-        runner,
-        "postProcess",
-        ["-funcs", "(writeCellCentres writeCellVolumes)", "-latestTime"],
-        workdir,
-        timeout=timeout,
-        log_name="log.postProcess.cells",
-    )
+    write_cell_centres(runner, workdir, timeout)
     rho = inputs["density"]
     cells = read_cell_fields(workdir, time_dir)
     volume = float(cells["V"].sum())

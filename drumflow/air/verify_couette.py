@@ -34,6 +34,7 @@ from drumflow.air.foam import (
     ResidualParser,
     latest_time,
     read_cell_fields,
+    write_cell_centres,
     write_control_dict,
     write_fv_schemes,
     write_mrf,
@@ -288,14 +289,7 @@ def verify_couette(
     run_foam(runner, "simpleFoam", [], workdir, timeout=timeout, on_line=parser)
     history = parser.finish()
     time_dir = latest_time(workdir)
-    run_foam(
-        runner,
-        "postProcess",
-        ["-funcs", "(writeCellCentres writeCellVolumes)", "-latestTime"],
-        workdir,
-        timeout=timeout,
-        log_name="log.postProcess.cells",
-    )
+    write_cell_centres(runner, workdir, timeout)
     data = read_cell_fields(workdir, time_dir)
     C, U = data["C"], data["U"]
     r = np.hypot(C[:, 0], C[:, 1])

@@ -33,7 +33,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from drumflow.dem.conduction import GEOMETRIC_AREA_FACTOR, liggghts_conductivity
+from drumflow.dem.conduction import liggghts_conductivity
 from drumflow.dem.deck import SOFT_PARTICLE_LIMIT, render_deck
 from drumflow.dem.thermo import ThermoParser
 from drumflow.dem.timestep import MIN_STEPS_PER_CONTACT, hertz_contact_time, rayleigh_time

@@ -15,7 +15,6 @@ import pytest
 from drumflow.air.field import (
     AirField,
     air_cache_key,
-    benchmark_sampling,
     fluid_mask_xy,
     local_linear_fit,
     plot_air_cross_section,

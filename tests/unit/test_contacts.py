@@ -7,16 +7,15 @@ import math
 
 import pytest
 
+from drumflow.dem.conduction import GEOMETRIC_AREA_FACTOR, liggghts_conductivity
 from drumflow.dem.timestep import MIN_STEPS_PER_CONTACT, hertz_contact_time, rayleigh_time
 from drumflow.verify.contacts import (
-    GEOMETRIC_AREA_FACTOR,
     decay_conductance,
     default_time_step,
     eq24_heat_flow,
     geometric_overlap_area,
     harmonic_conductivity,
     hertz_contact_radius,
-    liggghts_conductivity,
     liggghts_heat_flow,
     reference_overlap,
 )
