@@ -9,9 +9,9 @@ from pathlib import Path
 
 import pytest
 
+from drumflow.dem.conduction import GEOMETRIC_AREA_FACTOR
 from drumflow.runner import Runner
 from drumflow.verify.contacts import (
-    GEOMETRIC_AREA_FACTOR,
     PAPER_YOUNGS_MODULUS,
     contact_conduction_check,
     restitution_check,
