@@ -38,6 +38,16 @@ if TYPE_CHECKING:
 WALL_SIZE_FRACTION = 0.5
 
 
+
+def _area_and_perimeter(surface: int) -> tuple[float, float]:
+    """Area and perimeter of a synchronised OCC plane surface in the current gmsh model."""
+    import gmsh
+
+    area = gmsh.model.occ.getMass(2, surface)
+    curves = gmsh.model.getBoundary([(2, surface)], oriented=False)
+    perimeter = sum(gmsh.model.occ.getMass(1, abs(tag)) for _, tag in curves)
+    return area, perimeter
+
 def fluid_mesh_size(case: Case) -> float:
     """The bulk fluid cell size, m: ``air.mesh_size``, or drum diameter / 20 for ``"auto"``."""
     if case.air.mesh_size == "auto":
@@ -64,9 +74,7 @@ def cross_section_properties(case: Case) -> dict[str, float]:
         gmsh.model.add("section")
         surface = _build_cross_section(gmsh.model, case)
         gmsh.model.occ.synchronize()
-        area = gmsh.model.occ.getMass(2, surface)
-        curves = gmsh.model.getBoundary([(2, surface)], oriented=False)
-        perimeter = sum(gmsh.model.occ.getMass(1, abs(tag)) for _, tag in curves)
+        area, perimeter = _area_and_perimeter(surface)
     return {
         "area_m2": float(area),
         "perimeter_m": float(perimeter),
@@ -116,9 +124,7 @@ def write_fluid_mesh(case: Case, path: Path, size: float | None = None) -> dict[
         gmsh.model.add("fluid")
         surface = _build_cross_section(gmsh.model, case)
         gmsh.model.occ.synchronize()
-        area = gmsh.model.occ.getMass(2, surface)
-        curves = gmsh.model.getBoundary([(2, surface)], oriented=False)
-        perimeter = sum(gmsh.model.occ.getMass(1, abs(tag)) for _, tag in curves)
+        area, perimeter = _area_and_perimeter(surface)
         out = gmsh.model.occ.extrude([(2, surface)], 0.0, 0.0, length)
         gmsh.model.occ.synchronize()
         volumes = [tag for dim, tag in out if dim == 3]
