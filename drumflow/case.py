@@ -204,6 +204,18 @@ class Run(_Section):
     neighbor_skin: Positive | Literal["auto"] = Field(
         "auto", description="neighbour-list skin, m; 'auto' = 0.5 particle diameters"
     )
+    force_time_step: bool = Field(
+        False, description="run a fixed time_step above the stability limit anyway (stress tests)"
+    )
+    restitution_correction: bool = Field(
+        True, description="give LIGGGHTS the restitution that the time step realises as the "
+        "case's (drumflow.dem.restitution); off: pass the coefficients through"
+    )
+    wall_motion: Literal["auto", "moving_mesh", "static_shell"] = Field(
+        "auto", description="'moving_mesh': shell and lifters rotate as one mesh; "
+        "'static_shell': the cylinder stays put with a surface velocity, only the lifters move; "
+        "'auto': static_shell"
+    )
 
 
 class Plant(_Section):

@@ -24,6 +24,7 @@ from drumflow.dem.deck import (
     render_deck,
     short_plan,
 )
+from drumflow.dem.restitution import calibrate_case
 from drumflow.dem.placement import place_particles, write_data_file
 from drumflow.dem.thermo import ThermoParser
 from drumflow.dem.timestep import choose_time_step
@@ -160,7 +161,11 @@ def run_dem(
         positions = place_particles(case, n)
         write_data_file(case, positions, work / "particles.data", (geometry.box_lo, geometry.box_hi))
     rundir.record("dem_key", key)
-    files = DeckFiles(stl_file=str(Path("..") / geometry.stl))
+    files = DeckFiles(
+        stl_file=str(Path("..") / geometry.stl),
+        lifters_stl_file=str(Path("..") / geometry.lifters_stl) if geometry.lifters_stl else "",
+        static_shell=geometry.wall_motion == "static_shell",
+    )
     context = deck_context(
         case,
         plan,
@@ -172,6 +177,7 @@ def run_dem(
     deck_name = "in.drum" if resume is None else "in.drum.resume"
     (work / deck_name).write_text(render_deck(context))
     rundir.record("time_step", choice.as_dict())
+    rundir.record("restitution", {k: v.as_dict() for k, v in calibrate_case(case, plan.time_step).items()})
     rundir.record("output_every", plan.dump_every)
 
     total = plan.steps * plan.time_step

@@ -16,6 +16,7 @@ import jinja2
 
 from drumflow.dem.timestep import TimeStepChoice
 from drumflow.dem.conduction import liggghts_conductivity
+from drumflow.dem.restitution import calibrate_case
 
 if TYPE_CHECKING:
     from drumflow.case import Case
@@ -48,6 +49,10 @@ class DeckFiles:
 
     data_file: str = "particles.data"
     stl_file: str = "../geometry/walls.stl"
+    #: The lifters as their own moving mesh (static shell); "" = one moving mesh for all.
+    lifters_stl_file: str = ""
+    #: The shell STL is the bare cylinder, static with a surface velocity.
+    static_shell: bool = False
     cross_pattern: str = "dumps/cross.*.txt"
     snapshot_pattern: str = "dumps/snap.*.txt"
     restart_pattern: str = "restart/drum.*.restart"
@@ -137,6 +142,7 @@ def deck_context(
     """
     p = case.particles
     cc = case.contacts
+    restitution = calibrate_case(case, plan.time_step)
     E_wall = cc.wall_youngs_modulus if cc.wall_youngs_modulus is not None else p.youngs_modulus
     return {
         "case_name": case.name,
@@ -150,8 +156,10 @@ def deck_context(
         "E_wall": f"{E_wall:.9g}",
         "nu_particle": f"{p.poisson_ratio:.6g}",
         "nu_wall": f"{p.poisson_ratio:.6g}",
-        "e_pp": f"{cc.particle_particle.restitution:.6g}",
-        "e_pw": f"{cc.particle_wall.restitution:.6g}",
+        # The coefficients whose realised restitution at this time step is the case's
+        # (drumflow.dem.restitution): LIGGGHTS' discrete contact loses more than it is told.
+        "e_pp": f"{restitution['particle_particle'].liggghts_value:.6g}",
+        "e_pw": f"{restitution['particle_wall'].liggghts_value:.6g}",
         "mu_pp": f"{cc.particle_particle.friction:.6g}",
         "mu_pw": f"{cc.particle_wall.friction:.6g}",
         "mur_pp": f"{cc.particle_particle.rolling_friction:.6g}",
@@ -166,6 +174,9 @@ def deck_context(
         "dt": f"{plan.time_step:.9g}",
         "gravity": [f"{g:.9f}" for g in gravity_vector(case.drum.tilt_deg)],
         "stl_file": files.stl_file,
+        "lifters_stl_file": files.lifters_stl_file,
+        "static_shell": files.static_shell,
+        "omega": f"{case.drum.omega:.9g}",
         "length": f"{case.drum.length:.9g}",
         "period": f"{60.0 / case.drum.rpm:.9g}",
         "T0": p.initial_temperature_C,

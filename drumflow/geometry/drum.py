@@ -72,7 +72,7 @@ def simulation_box(case: Case) -> SimulationBox:
     return SimulationBox((-R - m, -R - m, -m), (R + m, R + m, case.drum.length + m))
 
 
-def _build_cross_section(gmsh_model: object, case: Case) -> int:
+def _build_cross_section(gmsh_model: object, case: Case, with_lifters: bool = True) -> int:
     """Create the shell disk minus lifters in OCC; return the surface tag."""
     import gmsh
 
@@ -80,7 +80,7 @@ def _build_cross_section(gmsh_model: object, case: Case) -> int:
     R = case.drum.radius
     disk = occ.addDisk(0.0, 0.0, 0.0, R, R)
     tools: list[tuple[int, int]] = []
-    for plate in all_plates(R, case.lifters):
+    for plate in all_plates(R, case.lifters) if with_lifters else []:
         corners = plate.corners()
         pts = [occ.addPoint(float(x), float(y), 0.0) for x, y in corners]
         lines = [occ.addLine(pts[i], pts[(i + 1) % 4]) for i in range(4)]
@@ -133,7 +133,7 @@ class _Gmsh:
         gmsh.finalize()
 
 
-def build_wall_mesh(case: Case, size: float | None = None) -> WallMesh:
+def build_wall_mesh(case: Case, size: float | None = None, with_lifters: bool = True) -> WallMesh:
     """Triangulate the shell and lifter surfaces of the section with gmsh.
 
     Parameters
@@ -142,6 +142,8 @@ def build_wall_mesh(case: Case, size: float | None = None) -> WallMesh:
         The validated case.
     size
         Facet edge length, m; default :func:`facet_size`.
+    with_lifters
+        ``False``: the bare cylinder (the static shell of ``run.wall_motion = "static_shell"``).
     """
     import gmsh
 
@@ -149,7 +151,7 @@ def build_wall_mesh(case: Case, size: float | None = None) -> WallMesh:
     length = case.drum.length
     with _Gmsh():
         gmsh.model.add("drum")
-        surface = _build_cross_section(gmsh.model, case)
+        surface = _build_cross_section(gmsh.model, case, with_lifters)
         gmsh.model.occ.extrude([(2, surface)], 0.0, 0.0, length)
         gmsh.model.occ.synchronize()
         groups = _classify_surfaces(length, 1e-6 * max(length, 1.0))
@@ -178,12 +180,31 @@ def build_wall_mesh(case: Case, size: float | None = None) -> WallMesh:
     return WallMesh(points[used].copy(), remap[triangles])
 
 
-def check_wall_mesh(mesh: WallMesh, case: Case) -> dict[str, float | int]:
+def _on_shell(points: NDArray[np.float64], radius: float) -> NDArray[np.bool_]:
+    return np.abs(np.hypot(points[..., 0], points[..., 1]) - radius) < 1e-6 * radius
+
+
+def lifter_part(mesh: WallMesh, radius: float) -> WallMesh:
+    """The lifters alone: the triangles of the combined walls not lying on the shell cylinder.
+
+    A shell facet has all three corners on the cylinder; a lifter face is a plate side, whose
+    corners cannot all sit on the cylinder without the triangle being degenerate.
+    """
+    on = _on_shell(mesh.points[mesh.triangles], radius).all(axis=1)
+    triangles = mesh.triangles[~on]
+    used = np.unique(triangles)
+    remap = np.full(len(mesh.points), -1, dtype=np.int64)
+    remap[used] = np.arange(len(used))
+    return WallMesh(mesh.points[used].copy(), remap[triangles])
+
+
+def check_wall_mesh(mesh: WallMesh, case: Case, open_at_shell: bool = False) -> dict[str, float | int]:
     """Check the wall mesh before LIGGGHTS sees it; return its statistics.
 
     Checks: no degenerate triangles (area or smallest angle); every edge shared by exactly two
     triangles except the open rims at the two end planes (the shell is closed around the
     circumference and along the lifters); every point inside the simulation box.
+    ``open_at_shell``: the lifters alone, open also where their feet meet the shell.
 
     Raises
     ------
@@ -215,6 +236,8 @@ def check_wall_mesh(mesh: WallMesh, case: Case) -> dict[str, float | int]:
     tol = 1e-6 * max(length, 1.0)
     z = p[open_edges][:, :, 2]
     on_rim = ((np.abs(z) < tol) | (np.abs(z - length) < tol)).all(axis=1)
+    if open_at_shell:
+        on_rim |= _on_shell(p[open_edges], case.drum.radius).all(axis=1)
     if not on_rim.all():
         raise GeometryError(
             f"the walls are open along {int((~on_rim).sum())} edges away from the end planes"

@@ -30,11 +30,30 @@ def test_deck_has_the_models(smoke_dict: dict) -> None:
     assert "heat/gran/conduction initial_temperature 90" in deck
     assert "fix spin all move/mesh mesh shell rotate origin 0. 0. 0. axis 0. 0. 1. period 4" in deck
     assert "coefficientFriction peratomtypepair 2 0.4 0.2 0.2 0.2" in deck
-    assert "coefficientRestitution peratomtypepair 2 0.1 0.3 0.3 0.3" in deck
+    # The corrected coefficients (drumflow.dem.restitution): above the case's 0.1 and 0.3.
+    e = deck.split("coefficientRestitution peratomtypepair 2 ")[1].split("\n")[0].split()
+    assert 0.1 < float(e[0]) < 0.15 and 0.3 < float(e[1]) < 0.33 and e[1] == e[2] == e[3]
     assert "thermo_modify   lost error" in deck
     assert "soft_particles" not in deck  # 5 MPa is not soft
     assert "read_data       particles.data" in deck
     assert "{{" not in deck and "{%" not in deck
+
+
+def test_restitution_passed_through_when_correction_is_off(smoke_dict: dict) -> None:
+    smoke_dict["run"]["restitution_correction"] = False
+    assert "coefficientRestitution peratomtypepair 2 0.1 0.3 0.3 0.3" in _deck(smoke_dict)
+
+
+def test_static_shell_deck_moves_only_the_lifters(smoke_dict: dict) -> None:
+    case = case_from_dict(smoke_dict)
+    plan = plan_steps(case, choose_time_step(case))
+    files = DeckFiles(stl_file="../geometry/shell.stl", lifters_stl_file="../geometry/lifters.stl",
+                      static_shell=True)
+    deck = render_deck(deck_context(case, plan, files))
+    omega = 15.0 * 2.0 * math.pi / 60.0
+    assert f"shell.stl type 2 surface_ang_vel origin 0. 0. 0. axis 0. 0. 1. omega {omega:.9g}" in deck
+    assert "meshes shell lifters" in deck
+    assert "move/mesh mesh lifters rotate" in deck and "move/mesh mesh shell" not in deck
 
 
 def test_soft_particles_and_resume(smoke_dict: dict) -> None:

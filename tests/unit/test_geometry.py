@@ -14,6 +14,7 @@ from drumflow.geometry.drum import (
     WallMesh,
     build_wall_mesh,
     check_wall_mesh,
+    lifter_part,
     simulation_box,
     write_ascii_stl,
 )
@@ -58,6 +59,25 @@ def test_wall_mesh_is_closed_and_checked(smoke_dict: dict, tmp_path: Path) -> No
     write_ascii_stl(mesh, path)
     text = path.read_text()
     assert text.startswith("solid") and text.count("facet normal") == stats["triangles"]
+
+
+def test_static_shell_parts(smoke_dict: dict) -> None:
+    """The bare cylinder is closed with area 2 pi R l (to faceting); the lifters alone are open
+    only at their feet and the end rims, and shell + lifters cover the combined walls."""
+    case = case_from_dict(smoke_dict)
+    R, length = case.drum.radius, case.drum.length
+    shell = build_wall_mesh(case, with_lifters=False)
+    shell_stats = check_wall_mesh(shell, case)
+    assert shell_stats["wall_area_m2"] == pytest.approx(2 * math.pi * R * length, rel=2e-3)
+    walls = build_wall_mesh(case)
+    lifters = lifter_part(walls, R)
+    lifter_stats = check_wall_mesh(lifters, case, open_at_shell=True)
+    with pytest.raises(GeometryError, match="open along"):
+        check_wall_mesh(lifters, case)
+    # Every lifter point lies inside the shell; lifters lose only shell facets.
+    assert np.hypot(lifters.points[:, 0], lifters.points[:, 1]).max() <= R * (1 + 1e-6)
+    walls_area = check_wall_mesh(walls, case)["wall_area_m2"]
+    assert lifter_stats["wall_area_m2"] < walls_area < lifter_stats["wall_area_m2"] + shell_stats["wall_area_m2"]
 
 
 def test_check_rejects_a_hole(smoke_dict: dict) -> None:
