@@ -88,6 +88,12 @@ class Particles(_Section):
     diameter: float = Field(gt=0, le=0.2, description="sphere diameter, m")
     density: float = Field(gt=0, le=20000, description="solid density, kg/m^3")
     youngs_modulus: float = Field(gt=1e3, le=1e12, description="Young's modulus, Pa")
+    youngs_modulus_reference: float | None = Field(
+        None, gt=1e3, le=1e12,
+        description="the material's real Young's modulus, Pa, when youngs_modulus is softened "
+        "for speed: contact conduction areas refer to it (LIGGGHTS area_correction); default: "
+        "youngs_modulus",
+    )
     poisson_ratio: float = Field(gt=0, lt=0.5, description="Poisson's ratio")
     heat_capacity: float = Field(gt=0, le=1e5, description="specific heat, J/(kg K)")
     conductivity: float = Field(gt=0, le=1e4, description="thermal conductivity, W/(m K)")
@@ -130,7 +136,8 @@ class Contact(_Section):
     """One contact pair's coefficients (Hertz-Mindlin with rolling resistance)."""
 
     friction: float = Field(ge=0, le=2, description="static (Coulomb) friction coefficient")
-    restitution: float = Field(gt=0.01, le=1, description="normal coefficient of restitution")
+    # LIGGGHTS 3.8 refuses coefficientRestitution <= 0.05.
+    restitution: float = Field(gt=0.05, le=1, description="normal coefficient of restitution")
     rolling_friction: float = Field(
         0.05, ge=0, le=1, description="rolling friction coefficient (CDT model)"
     )
@@ -203,6 +210,10 @@ class Run(_Section):
     )
     neighbor_skin: Positive | Literal["auto"] = Field(
         "auto", description="neighbour-list skin, m; 'auto' = 0.5 particle diameters"
+    )
+    conduction: bool = Field(
+        True, description="particle-particle heat conduction (paper Eq. 24); off: the particles "
+        "exchange heat with the air only"
     )
     force_time_step: bool = Field(
         False, description="run a fixed time_step above the stability limit anyway (stress tests)"

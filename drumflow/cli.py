@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import json
 import sys
+import time
 from pathlib import Path
 from typing import Annotated, Optional
 
@@ -389,6 +390,72 @@ def verify(
     console.print(f"written: {out / 'verification.json'}", highlight=False)
     if not all(c.passed for c in checks):
         raise typer.Exit(1)
+
+
+@app.command()
+def bench(
+    case_file: Annotated[Path, typer.Argument(help="reference scene: a case file (TOML)")],
+    out: Annotated[Optional[Path], typer.Option("--out", "-o", help="bench directory")] = None,
+    rungs: Annotated[Optional[str], typer.Option("--rungs", help="comma-separated rung names (default: all)")] = None,
+    time_s: Annotated[Optional[float], typer.Option("--time", min=0.01, help="simulated time per rung, s (default: the case's)")] = None,
+    timeout: Annotated[Optional[float], typer.Option("--timeout", min=1, help="solver time limit per rung, s")] = None,
+    list_only: Annotated[bool, typer.Option("--list", help="list the rungs and exit")] = False,
+) -> None:
+    """Run time against error: a ladder of settings on one scene -> results.csv and pareto.png."""
+    from drumflow.bench import run_bench
+    from drumflow.bench.ladder import ladder, select
+    from drumflow.case import case_from_dict
+
+    try:
+        case = _load(case_file)
+        if time_s is not None:
+            data = case.model_dump(mode="json")
+            data["run"]["time"] = time_s
+            data["run"]["mass_flow_start"] = min(case.run.mass_flow_start, 0.5 * time_s)
+            case = case_from_dict(data, source=case_file)
+        names = [n.strip() for n in rungs.split(",") if n.strip()] if rungs else None
+        chosen = select(ladder(case), names)
+    except (CaseError, ValueError) as exc:
+        _fail(exc, 2)
+        return
+    if list_only:
+        for r in chosen:
+            console.print(f"{r.name:18s} {r.group:12s} {r.description}", highlight=False)
+        return
+    out = out or Path("runs") / "bench" / case.name
+    t0 = time.monotonic()
+
+    def on_rung(rung, index: int, total: int, row: dict) -> None:  # type: ignore[no-untyped-def]
+        elapsed = time.monotonic() - t0
+        eta = elapsed / (index + 1) * (total - index - 1)
+        wall = row.get("dem_wall_time_s")
+        wall_txt = f"{wall:.1f} s" if isinstance(wall, (int, float)) else "-"
+        err_console.print(f"[{index + 1}/{total}] {rung.name}: {row['status'][:120]}, DEM {wall_txt} "
+                          f"(elapsed {elapsed / 60:.1f} min, ETA {eta / 60:.1f} min)", highlight=False)
+
+    try:
+        result = run_bench(case, out, names, timeout=timeout, on_rung=on_rung)
+    except DrumflowError as exc:
+        _fail(exc, 1)
+        return
+    except KeyboardInterrupt:
+        err_console.print(f"interrupted; run the same command again to resume into {out}")
+        raise typer.Exit(130) from None
+    table = Table(title=f"drumflow bench {case.name} → {out}")
+    cols = [("rung", "rung", "{}"), ("dt/t_R", "fraction_of_rayleigh", "{:.2f}"),
+            ("DEM s", "dem_wall_time_s", "{:.1f}"), ("speed-up", "speedup_vs_conservative", "{:.2f}"),
+            ("err T", "err_temperature", "{:.2%}"), ("err h", "err_h", "{:.2%}"),
+            ("err ṁ", "err_mass_flow", "{:.2%}"), ("front", "pareto", "{}")]
+    for title, _, _ in cols:
+        table.add_column(title)
+    for _, r in result.table.iterrows():
+        cells = []
+        for _, key, fmt in cols:
+            v = r.get(key)
+            cells.append("" if v is None or (isinstance(v, float) and v != v) else fmt.format(v))
+        table.add_row(*cells)
+    console.print(table)
+    console.print(f"written: {result.csv}, {result.json}, {result.plot}", highlight=False)
 
 
 def main() -> None:

@@ -119,6 +119,23 @@ class LostParticlesError(SolverError):
         super().__init__("liggghts", command, None, log, reason=what + when)
 
 
+class UnstableRunError(SolverError):
+    """The DEM run went numerically unstable and was stopped (drumflow.dem.stability).
+
+    Attributes
+    ----------
+    diagnosis
+        What broke, when, and the likely cause, in one line.
+    step
+        The DEM step of the thermo row that broke the bound.
+    """
+
+    def __init__(self, diagnosis: str, step: int, log: Path | None, command: Sequence[str] = ()) -> None:
+        self.diagnosis = diagnosis
+        self.step = step
+        super().__init__("liggghts", command, None, log, reason=f"run stopped: {diagnosis}")
+
+
 class InsertionError(DrumflowError, RuntimeError):
     """Fewer particles could be placed in the drum than the case asks for."""
 

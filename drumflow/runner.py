@@ -38,6 +38,15 @@ ERROR_PATTERNS = (
 )
 
 
+class StopRun(Exception):
+    """Raised by an ``on_line`` callback to stop the program: the runner kills its process
+    group and raises ``error`` instead (a monitor that found the run going wrong)."""
+
+    def __init__(self, error: BaseException) -> None:
+        super().__init__(str(error))
+        self.error = error
+
+
 @dataclass
 class RunRecord:
     """What happened when a program ran (goes into the manifest)."""
@@ -188,10 +197,14 @@ class Runner:
                 start_new_session=True,  # own process group: killpg reaches mpirun's ranks
             )
 
+            stops: list[StopRun] = []
+
             def notify(line: str) -> None:
-                if on_line is not None:
+                if on_line is not None and not stops:
                     try:
                         on_line(line)
+                    except StopRun as stop:
+                        stops.append(stop)
                     except Exception:  # a progress display must never kill a solver run
                         pass
 
@@ -214,7 +227,16 @@ class Runner:
                 )
                 follower.start()
             try:
-                proc.wait(timeout=timeout)
+                deadline = None if timeout is None else started + timeout
+                while True:
+                    try:
+                        proc.wait(timeout=0.2)
+                        break
+                    except subprocess.TimeoutExpired:
+                        if stops:
+                            break
+                        if deadline is not None and time.time() > deadline:
+                            raise
             except subprocess.TimeoutExpired:
                 stop_follow.set()
                 _kill_group(proc)
@@ -237,10 +259,24 @@ class Runner:
                 record.status = "interrupted"
                 record.wall_time_s = time.time() - started
                 raise
+            if stops:
+                # A monitor (on_line) found the run going wrong: stop it, report its error.
+                stop_follow.set()
+                _kill_group(proc)
+                reader.join(5)
+                record.status = "stopped"
+                record.wall_time_s = time.time() - started
+                raise stops[0].error
             reader.join()
             stop_follow.set()
             if follower is not None:
                 follower.join(5)
+            if stops:
+                # The monitor's verdict on the last lines outranks how the program ended.
+                record.returncode = proc.returncode
+                record.status = "stopped"
+                record.wall_time_s = time.time() - started
+                raise stops[0].error
         record.returncode = proc.returncode
         record.wall_time_s = time.time() - started
         lines = list(tail)

@@ -28,8 +28,10 @@ from drumflow.dem.restitution import calibrate_case
 from drumflow.dem.placement import place_particles, write_data_file
 from drumflow.dem.thermo import ThermoParser
 from drumflow.dem.timestep import choose_time_step
-from drumflow.errors import InsertionError, LostParticlesError, SolverError
+from drumflow.dem.stability import LOST_PREFIX, StabilityLimits, StabilityMonitor, stability_limits
+from drumflow.errors import InsertionError, LostParticlesError, SolverError, UnstableRunError
 from drumflow.rundir import hash_text
+from drumflow.runner import StopRun
 
 if TYPE_CHECKING:
     from drumflow.case import Case
@@ -101,6 +103,11 @@ def _latest_restart(folder: Path) -> tuple[Path, int] | None:
     return best
 
 
+def _stability_record(limits: StabilityLimits, monitor: StabilityMonitor, stopped: bool) -> dict:
+    return {"limits": limits.as_dict(), "stopped": stopped, "warnings": list(monitor.warnings),
+            "max_overlap_m": monitor.max_overlap, "max_kinetic_energy_J": monitor.max_kinetic_energy}
+
+
 def run_dem(
     case: Case,
     rundir: RunDir,
@@ -129,6 +136,8 @@ def run_dem(
 
     Raises
     ------
+    UnstableRunError
+        The stability monitor stopped the run (diagnosis in the message).
     LostParticlesError
         Particles left the domain.
     SolverError
@@ -184,6 +193,8 @@ def run_dem(
     parser = ThermoParser(
         on_time=(lambda t, _n: progress("dem", min(t, total), total)) if progress else None
     )
+    limits = stability_limits(case)
+    monitor = StabilityMonitor(limits, forced_time_step=choice.mode == "forced")
     # LIGGGHTS writes (and flushes) its own log, which feeds the progress bar; the runner
     # keeps standard output separately.
     suffix = "" if resume is None else f".resume-{resume[1]}"
@@ -220,12 +231,30 @@ def run_dem(
         command = runner.profile.mpi_command(program, case.run.processes)
     else:
         command = driver_command(runner.profile, case.run.processes)
+
+    def on_line(line: str) -> None:
+        # Every thermo row goes to the progress bar and to the stability monitor, which stops
+        # the run at the first row that breaks a physical bound.
+        before = len(parser.rows)
+        parser(line)
+        if len(parser.rows) == before:
+            return
+        row = parser.rows[-1]
+        diagnosis = monitor.check(int(row[0]), row[1], int(row[2]), row[3], row[4], row[6])
+        if diagnosis and diagnosis.startswith(LOST_PREFIX):
+            raise StopRun(LostParticlesError(n, int(row[2]), own_log, command, time_s=row[1]))
+        if diagnosis:
+            raise StopRun(UnstableRunError(diagnosis, int(row[0]), own_log, command))
+
     t0 = time.perf_counter()
     try:
         runner.run(
-            "liggghts", command, work, log, timeout=timeout, on_line=parser, check=check,
+            "liggghts", command, work, log, timeout=timeout, on_line=on_line, check=check,
             follow=own_log,
         )
+    except (UnstableRunError, LostParticlesError):
+        rundir.record("stability", _stability_record(limits, monitor, stopped=True))
+        raise
     except SolverError as err:
         if _LOST_RE.search(f"{err.reason} {err.last_error}"):
             last = parser.rows[-1] if parser.rows else None
@@ -237,6 +266,7 @@ def run_dem(
     finally:
         rundir.record_commands([r.as_dict() for r in runner.records if r.program == "liggghts"][-1:])
     wall = time.perf_counter() - t0
+    rundir.record("stability", _stability_record(limits, monitor, stopped=False))
     first_atoms = int(parser.rows[0][2]) if parser.rows else 0
     if resume is None and first_atoms != n:
         # read_data silently skips atoms outside the box: the count must be exact at step 0.

@@ -17,6 +17,7 @@ import jinja2
 from drumflow.dem.timestep import TimeStepChoice
 from drumflow.dem.conduction import liggghts_conductivity
 from drumflow.dem.restitution import calibrate_case
+from drumflow.dem.stability import CHECK_EVERY_STEPS
 
 if TYPE_CHECKING:
     from drumflow.case import Case
@@ -68,6 +69,8 @@ class StepPlan:
     dump_every: int  # crossing dump and thermo (mean temperature) output
     snapshot_every: int
     restart_every: int
+    #: Thermo rows (the stability monitor's input) every this many steps; divides dump_every.
+    thermo_every: int = 0
 
     @property
     def dump_interval(self) -> float:
@@ -77,7 +80,12 @@ class StepPlan:
 def plan_steps(case: Case, choice: TimeStepChoice) -> StepPlan:
     """Step counts for the run; output intervals are whole multiples of the output step."""
     dt = choice.time_step
-    dump_every = max(1, round(case.run.dump_interval / dt))
+    raw = max(1, round(case.run.dump_interval / dt))
+    # The output step is split into equal thermo intervals of at most CHECK_EVERY_STEPS (the
+    # stability monitor reads every thermo row), rounding it by less than 1/parts.
+    parts = math.ceil(raw / CHECK_EVERY_STEPS)
+    thermo_every = math.ceil(raw / parts)
+    dump_every = thermo_every * parts
     # A whole number of output steps, so that the last output falls on the last step.
     steps = math.ceil(case.run.time / dt / dump_every - 1e-9) * dump_every
 
@@ -85,13 +93,14 @@ def plan_steps(case: Case, choice: TimeStepChoice) -> StepPlan:
         return max(dump_every, round(interval / dt / dump_every) * dump_every)
 
     return StepPlan(dt, steps, dump_every, multiple(case.run.snapshot_interval),
-                    multiple(case.run.restart_interval))
+                    multiple(case.run.restart_interval), thermo_every)
 
 
 def short_plan(plan: StepPlan, steps: int) -> StepPlan:
     """A plan for only ``steps`` steps (start-up check): output at its end, no restarts."""
     every = min(plan.dump_every, steps)
-    return StepPlan(plan.time_step, steps, every, min(plan.snapshot_every, steps), 0)
+    return StepPlan(plan.time_step, steps, every, min(plan.snapshot_every, steps), 0,
+                    math.gcd(plan.thermo_every or every, every))
 
 
 def crossing_band(case: Case, plan: StepPlan) -> float:
@@ -168,8 +177,9 @@ def deck_context(
         # factor: sqrt of the overlap area against the Hertzian contact radius), and k enters
         # linearly, so LIGGGHTS gets k / sqrt(2 pi). See drumflow.verify.contacts.
         "k_particle": f"{liggghts_conductivity(p.conductivity):.9g}",
-        "E_reference_particle": f"{p.youngs_modulus:.9g}",
-        "E_reference_wall": f"{E_wall:.9g}",
+        # Softened for speed: the conduction contact area still refers to the real modulus.
+        "E_reference_particle": f"{p.youngs_modulus_reference or p.youngs_modulus:.9g}",
+        "E_reference_wall": f"{(cc.wall_youngs_modulus or p.youngs_modulus_reference or E_wall):.9g}",
         "cp_particle": f"{p.heat_capacity:.9g}",
         "dt": f"{plan.time_step:.9g}",
         "gravity": [f"{g:.9f}" for g in gravity_vector(case.drum.tilt_deg)],
@@ -181,7 +191,7 @@ def deck_context(
         "period": f"{60.0 / case.drum.rpm:.9g}",
         "T0": p.initial_temperature_C,
         "temperature_spread": p.initial_temperature_spread_C,
-        "thermo_every": plan.dump_every,
+        "thermo_every": plan.thermo_every or plan.dump_every,
         "dump_every": plan.dump_every,
         "snapshot_every": plan.snapshot_every,
         "cross_pattern": files.cross_pattern,
@@ -193,6 +203,7 @@ def deck_context(
         "steps": plan.steps,
         "extra_commands": extra_commands,
         "coupled": coupled,
+        "conduction": case.run.conduction,
     }
 
 

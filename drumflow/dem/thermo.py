@@ -1,6 +1,6 @@
 """LIGGGHTS thermo output: live progress while running, and the time series afterwards.
 
-The deck's thermo style is ``step v_sim_time atoms ke c_ke_rot v_T_mean cpu``; ``v_T_mean`` is
+The deck's thermo style is ``step v_sim_time atoms ke c_ke_rot v_T_mean c_overlap_max cpu``; ``v_T_mean`` is
 the mass-weighted mean particle temperature computed inside LIGGGHTS over all particles, at
 every output step. The series is rebuilt from LIGGGHTS' own log files (the first attempt and
 every resume), so an interrupted run loses nothing and ``drumflow post`` needs no solver.
@@ -15,7 +15,9 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-COLUMNS = ("step", "time", "atoms", "ke", "ke_rot", "T_mean", "cpu")
+COLUMNS = ("step", "time", "atoms", "ke", "ke_rot", "T_mean", "overlap_max", "cpu")
+#: Runs made before the overlap column existed (their logs stay readable by `drumflow post`).
+LEGACY_COLUMNS = ("step", "time", "atoms", "ke", "ke_rot", "T_mean", "cpu")
 
 
 class ThermoParser:
@@ -73,10 +75,17 @@ def read_thermo(dem_dir: Path, every: int | None = None) -> pd.DataFrame:
     frames = []
     for order, path in enumerate(log_files(dem_dir)):
         parser = ThermoParser()
+        legacy = ThermoParser(columns=LEGACY_COLUMNS)
         with path.open("r", errors="replace") as fh:
             for line in fh:
                 parser(line)
-        if parser.rows:
+                legacy(line)
+        if not parser.rows and legacy.rows:
+            frame = pd.DataFrame(np.array(legacy.rows), columns=list(LEGACY_COLUMNS))
+            frame.insert(6, "overlap_max", np.nan)
+            frame["attempt"] = order
+            frames.append(frame)
+        elif parser.rows:
             frame = pd.DataFrame(np.array(parser.rows), columns=list(COLUMNS))
             frame["attempt"] = order
             frames.append(frame)

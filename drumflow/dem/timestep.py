@@ -66,7 +66,7 @@ class TimeStepChoice:
     hertz_time: float
     fraction_of_rayleigh: float
     steps_per_contact: float
-    mode: str  # "auto" or "fixed"
+    mode: str  # "auto", "fixed", or "forced" (fixed above the stability limit, on request)
 
     def as_dict(self) -> dict[str, Any]:
         return asdict(self)
@@ -99,13 +99,15 @@ def choose_time_step(case: Case) -> TimeStepChoice:
         dt = float(case.run.time_step)
         mode = "fixed"
         limit = min(0.5 * t_r, t_h / MIN_STEPS_PER_CONTACT)
-        if dt > limit:
+        if dt > limit and case.run.force_time_step:
+            mode = "forced"  # a stress test: the stability monitor will stop it if it blows up
+        elif dt > limit:
             raise CaseError(
                 [
                     f"run.time_step = {dt:g} s: above the stability limit {limit:.3g} s "
                     f"(half the Rayleigh time {t_r:.3g} s, and at least "
                     f"{MIN_STEPS_PER_CONTACT:g} steps per Hertz contact of {t_h:.3g} s); "
-                    "use 'auto' or a smaller value"
+                    "use 'auto' or a smaller value (or run.force_time_step = true to try it)"
                 ]
             )
     return TimeStepChoice(

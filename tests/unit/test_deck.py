@@ -33,7 +33,7 @@ def test_deck_has_the_models(smoke_dict: dict) -> None:
     # The corrected coefficients (drumflow.dem.restitution): above the case's 0.1 and 0.3.
     e = deck.split("coefficientRestitution peratomtypepair 2 ")[1].split("\n")[0].split()
     assert 0.1 < float(e[0]) < 0.15 and 0.3 < float(e[1]) < 0.33 and e[1] == e[2] == e[3]
-    assert "thermo_modify   lost error" in deck
+    assert "thermo_modify   lost warn" in deck
     assert "soft_particles" not in deck  # 5 MPa is not soft
     assert "read_data       particles.data" in deck
     assert "{{" not in deck and "{%" not in deck

@@ -80,3 +80,28 @@ def test_follow_reads_the_programs_own_log_while_it_runs(tmp_path: Path) -> None
     # The first line arrived while the program was still running (it runs ~1.8 s).
     assert seen[0][0] < 1.2
     assert "stdout-only" in (tmp_path / "out.txt").read_text()
+
+
+def test_monitor_stop_kills_the_program_and_raises_its_error(tmp_path: Path) -> None:
+    """An on_line callback raising StopRun ends a 10 s program within seconds, with its error."""
+    from drumflow.runner import StopRun
+
+    def monitor(line: str) -> None:
+        if line.strip() == "row 3":
+            raise StopRun(ArithmeticError("diverged at row 3"))
+
+    runner = Runner()
+    t0 = time.time()
+    with pytest.raises(ArithmeticError, match="row 3"):
+        runner.run("sh", ["sh", "-c", "for i in $(seq 1 100); do echo row $i; sleep 0.1; done"],
+                   tmp_path, tmp_path / "log.txt", on_line=monitor)
+    assert time.time() - t0 < 6
+    assert runner.records[-1].status == "stopped"
+
+
+def test_other_callback_errors_never_stop_the_program(tmp_path: Path) -> None:
+    def broken(line: str) -> None:
+        raise ValueError("a progress bar bug")
+
+    rec = Runner().run("sh", ["sh", "-c", "echo a; echo b"], tmp_path, tmp_path / "log.txt", on_line=broken)
+    assert rec.status == "ok"
