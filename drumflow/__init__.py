@@ -18,6 +18,7 @@ from drumflow.errors import (
     SolverError,
     SolverNotFoundError,
     SolverTimeoutError,
+    UnstableRunError,
 )
 from drumflow.pipeline import post_run, run_case
 
@@ -34,6 +35,7 @@ __all__ = [
     "SolverError",
     "SolverNotFoundError",
     "SolverTimeoutError",
+    "UnstableRunError",
     "case_from_dict",
     "load_case",
     "post_run",

@@ -400,6 +400,7 @@ def bench(
     time_s: Annotated[Optional[float], typer.Option("--time", min=0.01, help="simulated time per rung, s (default: the case's)")] = None,
     timeout: Annotated[Optional[float], typer.Option("--timeout", min=1, help="solver time limit per rung, s")] = None,
     list_only: Annotated[bool, typer.Option("--list", help="list the rungs and exit")] = False,
+    speed_only: Annotated[bool, typer.Option("--speed-only", help="no reference rung: run times only")] = False,
 ) -> None:
     """Run time against error: a ladder of settings on one scene -> results.csv and pareto.png."""
     from drumflow.bench import run_bench
@@ -414,7 +415,7 @@ def bench(
             data["run"]["mass_flow_start"] = min(case.run.mass_flow_start, 0.5 * time_s)
             case = case_from_dict(data, source=case_file)
         names = [n.strip() for n in rungs.split(",") if n.strip()] if rungs else None
-        chosen = select(ladder(case), names)
+        chosen = select(ladder(case), names, speed_only)
     except (CaseError, ValueError) as exc:
         _fail(exc, 2)
         return
@@ -434,7 +435,7 @@ def bench(
                           f"(elapsed {elapsed / 60:.1f} min, ETA {eta / 60:.1f} min)", highlight=False)
 
     try:
-        result = run_bench(case, out, names, timeout=timeout, on_rung=on_rung)
+        result = run_bench(case, out, names, timeout=timeout, on_rung=on_rung, speed_only=speed_only)
     except DrumflowError as exc:
         _fail(exc, 1)
         return

@@ -135,7 +135,7 @@ def _prepare_cfd(
             if progress:
                 progress("air (OpenFOAM)", min(float(iteration), total), total)
 
-        solution = solve_air(case, work, runner, processes=case.run.processes,
+        solution = solve_air(case, work, runner, processes=case.process_count,
                              on_iteration=on_iteration)
         field_ = AirField.from_solution(solution, case)
         cache.mkdir(parents=True, exist_ok=True)

@@ -141,16 +141,16 @@ def apply_rung(case: Case, rung: Rung) -> Case:
     return case_from_dict(data)
 
 
-def select(rungs: list[Rung], names: list[str] | None) -> list[Rung]:
-    """Only the named rungs (plus the reference, which every error needs, and a by-hand
-    rung's base)."""
+def select(rungs: list[Rung], names: list[str] | None, speed_only: bool = False) -> list[Rung]:
+    """Only the named rungs (plus the reference, which every error needs, unless
+    ``speed_only``, and a by-hand rung's base)."""
     if not names:
-        return rungs
+        return [r for r in rungs if not (speed_only and r.name == REFERENCE)]
     known = {r.name for r in rungs}
     unknown = [n for n in names if n not in known]
     if unknown:
         raise ValueError(f"unknown rung(s) {', '.join(unknown)}; known: {', '.join(sorted(known))}")
-    wanted = set(names) | {REFERENCE}
+    wanted = set(names) if speed_only else set(names) | {REFERENCE}
     wanted |= {r.base for r in rungs if r.name in wanted and r.base}
     return [r for r in rungs if r.name in wanted]
 

@@ -15,6 +15,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from drumflow.bench.skips import skips
 from drumflow.coupling import driver_command
 from drumflow.dem.deck import (
     DeckFiles,
@@ -188,6 +189,8 @@ def run_dem(
     rundir.record("time_step", choice.as_dict())
     rundir.record("restitution", {k: v.as_dict() for k, v in calibrate_case(case, plan.time_step).items()})
     rundir.record("output_every", plan.dump_every)
+    rundir.record("processes", case.process_count)
+    rundir.record("skips", skips(case, choice.mode, air is not None, geometry.wall_motion))
 
     total = plan.steps * plan.time_step
     parser = ThermoParser(
@@ -228,9 +231,9 @@ def run_dem(
         }
         (work / "coupling.json").write_text(json.dumps(spec, indent=2))
     if air is None:
-        command = runner.profile.mpi_command(program, case.run.processes)
+        command = runner.profile.mpi_command(program, case.process_count)
     else:
-        command = driver_command(runner.profile, case.run.processes)
+        command = driver_command(runner.profile, case.process_count)
 
     def on_line(line: str) -> None:
         # Every thermo row goes to the progress bar and to the stability monitor, which stops

@@ -121,7 +121,7 @@ def gravity_vector(tilt_deg: float) -> tuple[float, float, float]:
 
 def processors_grid(case: Case) -> str:
     """MPI decomposition: along the axis for long sections, across it for thin slices."""
-    n = case.run.processes
+    n = case.process_count
     if n == 1:
         return "1 1 1"
     if case.drum.length >= case.drum.diameter:
