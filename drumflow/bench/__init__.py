@@ -184,8 +184,13 @@ def run_bench(
     out.mkdir(parents=True, exist_ok=True)
     rows: list[dict[str, Any]] = []
     done: dict[str, tuple[Case, Path]] = {}
+    # The overhead pair is timed side by side, never from an earlier bench: a reused run would
+    # compare timings taken at different times (run-to-run spread here is several percent).
+    fresh = {r.base for r in rungs if r.by_hand and r.base}
     for index, rung in enumerate(rungs):
         run = out / "rungs" / rung.name
+        if rung.name in fresh and run.exists():
+            shutil.rmtree(run)
         if rung.by_hand:
             base = done.get(rung.base or "")
             if base is None:
