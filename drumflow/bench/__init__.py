@@ -235,7 +235,8 @@ def run_bench(
     csv = out / "results.csv"
     table.to_csv(csv, index=False, float_format="%.6g")
     js = out / "results.json"
-    js.write_text(json.dumps({"summary": summary_out, "rows": rows}, indent=2, default=str))
+    records = json.loads(table.to_json(orient="records"))  # with the errors, NaN as null
+    js.write_text(json.dumps({"summary": summary_out, "rows": records}, indent=2, default=str))
     plot = out / "pareto.png"
     plot_pareto(table, plot, TOLERANCES, title=f"drumflow bench: {case.name}")
     return BenchResult(table, summary_out, csv, js, plot)
@@ -294,7 +295,8 @@ def _summarise(table: pd.DataFrame, case: Case) -> dict[str, Any]:
             "error_over_tolerance", "fraction_of_rayleigh", "steps_per_contact")}
         out["default_meets_issue"] = bool(
             (default.get("speedup_vs_conservative") or 0) >= 3.0
-            and all((default.get(f"err_{k}") or 0) <= tol for k, tol in TOLERANCES.items()))
+            and all(default.get(f"err_{k}") is not None and default[f"err_{k}"] <= tol
+                    for k, tol in TOLERANCES.items()))
     if noise:
         out["noise_floor"] = {k: noise.get(f"err_{k}") for k in TOLERANCES}
     hand, mine = row("no_air_by_hand"), row("no_air")

@@ -35,6 +35,18 @@ def plot_pareto(table: pd.DataFrame, path: Path, tolerances: dict[str, float], t
 
     ok = table[(table["status"] == "ok") & table["dem_wall_time_s"].notna()].copy()
     fig, ax = plt.subplots(figsize=(8.0, 5.5), dpi=120)
+    has_errors = "error_over_tolerance" in ok and ok["error_over_tolerance"].notna().any()
+    if not has_errors:
+        # A speed-only bench (no reference): run times alone, as bars.
+        ax.barh(ok["rung"], ok["dem_wall_time_s"].astype(float), color="tab:blue")
+        ax.invert_yaxis()
+        ax.set_xlabel("DEM wall time (s)")
+        ax.set_title(title + " (run time only: no reference rung)", fontsize=10)
+        fig.tight_layout()
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fig.savefig(path)
+        plt.close(fig)
+        return
     floor = 1e-3  # the reference itself has zero error: draw it on the floor of the log axis
     ok["y"] = ok["error_over_tolerance"].fillna(np.nan).clip(lower=floor)
     groups = list(dict.fromkeys(ok["group"]))

@@ -101,3 +101,19 @@ def test_errors_scores_and_plot(tmp_path: Path) -> None:
     assert d.loc[REFERENCE, "pareto"] and d.loc["default", "pareto"]
     plot_pareto(table, tmp_path / "p.png", TOLERANCES, "test")
     assert (tmp_path / "p.png").stat().st_size > 10_000
+
+
+def test_speed_only_table_plots_run_times(tmp_path: Path) -> None:
+    """Regression: a --speed-only bench has no errors, and the log-scaled error axis raised
+    'Data cannot be log-scaled' after every rung had run."""
+    table = pd.DataFrame([
+        {"rung": CONSERVATIVE, "group": "conservative", "status": "ok", "dem_wall_time_s": 52.3,
+         "cooling_K": 0.0, "falling_mass_flow_kg_s": math.nan, "h_W_m2K": math.nan},
+        {"rung": "default", "group": "default", "status": "ok", "dem_wall_time_s": 41.2,
+         "cooling_K": 0.0, "falling_mass_flow_kg_s": math.nan, "h_W_m2K": math.nan},
+    ])
+    _add_errors(table)
+    assert table["error_over_tolerance"].isna().all()
+    assert table.set_index("rung").loc["default", "speedup_vs_conservative"] == pytest.approx(52.3 / 41.2)
+    plot_pareto(table, tmp_path / "p.png", TOLERANCES, "speed only")
+    assert (tmp_path / "p.png").stat().st_size > 5_000
