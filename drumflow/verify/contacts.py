@@ -285,7 +285,7 @@ def restitution_check(
     rule = "drumflow's default rule" if steps_per_contact is None else "t_Hertz / n"
     n = results[0].steps_per_contact
     return Check(
-        name=f"restitution_e{restitution:g}_E{youngs_modulus:.3g}_n{n:.0f}"
+        name=f"restitution_e{restitution:g}_E{youngs_modulus:.3g}_v{speed:g}_n{n:.0f}"
              + ("" if correction else "_uncorrected"),
         measured=mean, expected=restitution,
         error=relative_error(mean, restitution), tolerance=tolerance,
