@@ -276,8 +276,8 @@ def run_dem(
         raise InsertionError(n, first_atoms, "LIGGGHTS read fewer particles than were placed")
     final_atoms = int(parser.rows[-1][2]) if parser.rows else n
     if final_atoms != n:
-        # `thermo_modify lost error` should have stopped the run; this is a second line of
-        # defence, e.g. against a deck edited by hand.
+        # The stability monitor should have stopped the run at the first row with fewer atoms;
+        # this is a second line of defence, e.g. against a deck edited by hand.
         raise LostParticlesError(n, final_atoms, log, command)
     steps_run = plan.steps - (resume[1] if resume else 0)
     result = DemResult(
