@@ -173,7 +173,7 @@ def hertz_time_effective(effective_mass: float, effective_radius: float,
 def pair_properties(case: Case, wall: bool) -> tuple[float, float, float]:
     """m* (kg), R* (m) and E* (Pa) of a particle-particle or particle-wall contact."""
     p = case.particles
-    mass = p.density * math.pi / 6.0 * p.diameter**3
+    mass = p.mass
     e_wall = case.contacts.wall_youngs_modulus or p.youngs_modulus
     if wall:
         # The wall (mesh or plane) has the particles' Poisson ratio in the deck.

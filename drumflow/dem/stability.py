@@ -32,6 +32,8 @@ import math
 from dataclasses import asdict, dataclass, field
 from typing import TYPE_CHECKING, Any
 
+from drumflow.dem.restitution import pair_properties
+
 if TYPE_CHECKING:
     from drumflow.case import Case
 
@@ -83,8 +85,8 @@ def static_overlap(case: Case) -> float:
     """
     p = case.particles
     force = BED_SOLIDS_FRACTION * p.density * G * bed_depth(case) * p.diameter**2
-    e_eff = p.youngs_modulus / (2.0 * (1.0 - p.poisson_ratio**2))
-    return hertz_overlap(force, 0.5 * p.radius, e_eff)
+    _, r_eff, e_eff = pair_properties(case, wall=False)
+    return hertz_overlap(force, r_eff, e_eff)
 
 
 @dataclass(frozen=True)
@@ -110,15 +112,14 @@ def stability_limits(case: Case) -> StabilityLimits:
 
     p = case.particles
     n = case.particle_count
-    mass = p.density * math.pi / 6.0 * p.diameter**3
     v = impact_velocity(case)
-    e_eff = p.youngs_modulus / (2.0 * (1.0 - p.poisson_ratio**2))
+    m_eff, r_eff, e_eff = pair_properties(case, wall=False)
     static = static_overlap(case)
-    impact = impact_overlap(v, 0.5 * mass, 0.5 * p.radius, e_eff)
+    impact = impact_overlap(v, m_eff, r_eff, e_eff)
     stop = min(max(OVERLAP_STOP_FACTOR * max(static, impact), 0.2 * p.radius), 0.9 * p.diameter)
     return StabilityLimits(
         particles=n, radius=p.radius, fastest_speed=v,
-        kinetic_energy_limit=n * 0.5 * mass * (SPEED_MARGIN * v) ** 2,
+        kinetic_energy_limit=n * 0.5 * p.mass * (SPEED_MARGIN * v) ** 2,
         static_overlap=static, impact_overlap=impact,
         overlap_warning=OVERLAP_WARNING_FRACTION * p.radius, overlap_stop=stop,
     )
