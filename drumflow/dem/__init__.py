@@ -25,7 +25,6 @@ from drumflow.dem.deck import (
     render_deck,
     short_plan,
 )
-from drumflow.dem.restitution import calibrate_case
 from drumflow.dem.placement import place_particles, write_data_file
 from drumflow.dem.thermo import ThermoParser
 from drumflow.dem.timestep import choose_time_step
@@ -187,7 +186,7 @@ def run_dem(
     deck_name = "in.drum" if resume is None else "in.drum.resume"
     (work / deck_name).write_text(render_deck(context))
     rundir.record("time_step", choice.as_dict())
-    rundir.record("restitution", {k: v.as_dict() for k, v in calibrate_case(case, plan.time_step).items()})
+    rundir.record("restitution", context["restitution_calibration"])
     rundir.record("output_every", plan.dump_every)
     rundir.record("processes", case.process_count)
     rundir.record("skips", skips(case, choice.mode, air is not None, geometry.wall_motion))

@@ -204,6 +204,8 @@ def deck_context(
         "extra_commands": extra_commands,
         "coupled": coupled,
         "conduction": case.run.conduction,
+        # Not used by the template: the record of how e_pp and e_pw were chosen (manifest).
+        "restitution_calibration": {k: v.as_dict() for k, v in restitution.items()},
     }
 
 

@@ -33,7 +33,12 @@ def _manifest(run: Path) -> dict:
 
 
 def _assert_clean(run: Path, particles: int) -> None:
-    stability = _manifest(run)["stability"]
+    manifest = _manifest(run)
+    # What the run chose is on record: the corrected restitution and the shortcuts taken.
+    assert manifest["restitution"]["particle_particle"]["target"] == 0.1
+    assert manifest["restitution"]["particle_particle"]["liggghts_value"] >= 0.1
+    assert any(s["skip"].startswith("static shell") for s in manifest["skips"])
+    stability = manifest["stability"]
     assert stability["stopped"] is False
     assert stability["max_kinetic_energy_J"] < stability["limits"]["kinetic_energy_limit"]
     series = pd.read_csv(run / "post" / "mean_temperature.csv")
