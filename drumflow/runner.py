@@ -226,6 +226,13 @@ class Runner:
                     target=_follow_file, args=(follow, notify, stop_follow), daemon=True
                 )
                 follower.start()
+            def halt(status: str) -> None:
+                stop_follow.set()
+                _kill_group(proc)
+                reader.join(5)
+                record.status = status
+                record.wall_time_s = time.time() - started
+
             try:
                 deadline = None if timeout is None else started + timeout
                 while True:
@@ -238,11 +245,7 @@ class Runner:
                         if deadline is not None and time.time() > deadline:
                             raise
             except subprocess.TimeoutExpired:
-                stop_follow.set()
-                _kill_group(proc)
-                reader.join(5)
-                record.status = "timeout"
-                record.wall_time_s = time.time() - started
+                halt("timeout")
                 raise SolverTimeoutError(
                     program,
                     command,
@@ -253,26 +256,18 @@ class Runner:
                 ) from None
             except BaseException:
                 # Ctrl-C (KeyboardInterrupt) or anything else: never leave solvers behind.
-                stop_follow.set()
-                _kill_group(proc)
-                reader.join(5)
-                record.status = "interrupted"
-                record.wall_time_s = time.time() - started
+                halt("interrupted")
                 raise
             if stops:
-                # A monitor (on_line) found the run going wrong: stop it, report its error.
-                stop_follow.set()
+                # A monitor (on_line) found the run going wrong: stop it; its error is raised
+                # below, once the output threads have finished.
                 _kill_group(proc)
-                reader.join(5)
-                record.status = "stopped"
-                record.wall_time_s = time.time() - started
-                raise stops[0].error
             reader.join()
             stop_follow.set()
             if follower is not None:
                 follower.join(5)
             if stops:
-                # The monitor's verdict on the last lines outranks how the program ended.
+                # The monitor's verdict (also on the last lines) outranks how the program ended.
                 record.returncode = proc.returncode
                 record.status = "stopped"
                 record.wall_time_s = time.time() - started
