@@ -13,10 +13,9 @@ from __future__ import annotations
 import hashlib
 import json
 import math
-import os
 import tomllib
 from pathlib import Path
-from typing import Annotated, Any, Literal
+from typing import Annotated, Any, Literal, TypeVar
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
@@ -234,6 +233,25 @@ class Run(_Section):
         "'static_shell': the cylinder stays put with a surface velocity, only the lifters move; "
         "'auto': static_shell"
     )
+    stop: Literal["fixed", "converged"] = Field(
+        "fixed", description="'fixed': run for run.time; 'converged': end as soon as the air's "
+        "heat-transfer coefficient and the falling mass flow are both known to run.stop_tolerance "
+        "(95% batch-means intervals, drumflow.convergence), at the latest at run.time"
+    )
+    stop_tolerance: float = Field(
+        0.01, gt=0, le=0.5, description="'converged' stop: largest relative half-width of the "
+        "95% intervals of h and of the falling mass flow"
+    )
+    stop_min_time: Positive | Literal["auto"] = Field(
+        "auto", description="'converged' stop: never before this simulated time, s; 'auto' = "
+        "mass_flow_start + the longer of 1 s and three lifter passing periods"
+    )
+    crossings: Literal["dump", "loop"] = Field(
+        "dump", description="how the axis-plane crossings are found: 'dump': LIGGGHTS writes the "
+        "particles near the plane at every output step (text, about 3 GB for the paper's model "
+        "one); 'loop': the air coupling loop finds them in memory and writes only the crossings "
+        "(dem/coupling/crossings.csv; needs air)"
+    )
 
 
 class Plant(_Section):
@@ -339,6 +357,31 @@ class Case(_Section):
                 f"run.mass_flow_start = {self.run.mass_flow_start} s: must be below run.time "
                 f"({self.run.time} s)"
             )
+        if self.run.stop == "converged" and self.air.model == "none":
+            problems.append(
+                "run.stop = 'converged': needs air (the stop rule watches the air's heat-transfer "
+                "coefficient); allowed with air.model = 'uniform' or 'cfd', else run.stop = 'fixed'"
+            )
+        if self.run.crossings == "loop" and self.air.model == "none":
+            problems.append(
+                "run.crossings = 'loop': needs air (the coupling loop finds them); allowed with "
+                "air.model = 'uniform' or 'cfd', else run.crossings = 'dump'"
+            )
+        if self.run.stop_min_time != "auto" and not (
+                self.run.mass_flow_start < self.run.stop_min_time <= self.run.time):
+            problems.append(
+                f"run.stop_min_time = {self.run.stop_min_time} s: must be above "
+                f"run.mass_flow_start ({self.run.mass_flow_start} s) and at most run.time "
+                f"({self.run.time} s)"
+            )
+        size = self.air.mesh_size
+        if size != "auto" and size > self.drum.diameter:
+            # A cell larger than the drum cannot resolve it (gmsh would make a handful of
+            # degenerate cells, or none): refuse it before any mesher runs.
+            problems.append(
+                f"air.mesh_size = {size:g} m: must be at most the drum diameter "
+                f"({self.drum.diameter:g} m)"
+            )
         if problems:
             raise ValueError("\n".join(problems))
         return self
@@ -354,17 +397,18 @@ class Case(_Section):
         solids = self.particles.fill_fraction * drum_volume * BED_SOLIDS_FRACTION
         return max(1, round(solids / self.particles.volume))
 
-    @property
-    def process_count(self) -> int:
-        """MPI processes for the run: ``run.processes``, or the 'auto' choice.
+    def processes(self, cores: int) -> int:
+        """MPI processes for the run on a machine with ``cores`` cores: ``run.processes``, or
+        the 'auto' choice.
 
         'auto' keeps at least :data:`PARTICLES_PER_PROCESS` particles on each process: with
         fewer, halo exchange outweighs the split (measured here: 3,000 particles on 2 ranks
-        ran only 1.12 times faster, a 500-particle drum slower than serial).
+        ran only 1.12 times faster, a 500-particle drum slower than serial). The core count
+        comes from the launch profile (:meth:`drumflow.runner.LaunchProfile.processes_for`), so
+        the case model itself never looks at the machine.
         """
         if self.run.processes != "auto":
             return int(self.run.processes)
-        cores = os.cpu_count() or 1
         return max(1, min(cores, self.particle_count // PARTICLES_PER_PROCESS))
 
     @property
@@ -372,8 +416,19 @@ class Case(_Section):
         return self.particle_count * self.particles.mass
 
     def canonical_json(self) -> str:
-        """The case as canonical JSON (sorted keys), the basis of its hash."""
-        return json.dumps(self.model_dump(mode="json"), sort_keys=True, separators=(",", ":"))
+        """The case as canonical JSON (sorted keys), the basis of its hash.
+
+        A fixed-time run leaves out the 'converged' stop rule's fields, and a run with the
+        crossing dump its ``run.crossings``, so that cases written before these options existed
+        keep their hash (and their run directories and caches).
+        """
+        data = self.model_dump(mode="json")
+        if data["run"]["stop"] == "fixed":
+            for name in ("stop", "stop_tolerance", "stop_min_time"):
+                del data["run"][name]
+        if data["run"]["crossings"] == "dump":
+            del data["run"]["crossings"]
+        return json.dumps(data, sort_keys=True, separators=(",", ":"))
 
     def hash(self) -> str:
         """SHA-256 of the canonical case, identifying a run's inputs."""
@@ -436,6 +491,42 @@ def _merge_problems(errors: list[dict[str, Any]]) -> list[str]:
     return lines
 
 
+_Model = TypeVar("_Model", bound=BaseModel)
+
+
+def validate_model(model: type[_Model], data: dict[str, Any],
+                   source: Path | str | None = None) -> _Model:
+    """Validate nested dictionaries into any drumflow input model (drum case, cooler case,
+    sweep file), with every problem named by field, value and allowed range.
+
+    Raises
+    ------
+    CaseError
+        Listing every problem.
+    """
+    try:
+        return model.model_validate(data)
+    except ValidationError as exc:
+        raise CaseError(_merge_problems([dict(e) for e in exc.errors()]), source) from None
+
+
+def read_toml(path: Path | str) -> dict[str, Any]:
+    """Read a TOML input file.
+
+    Raises
+    ------
+    CaseError
+        When the file is missing or is not valid TOML.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise CaseError([f"case file {path}: not found"], path)
+    try:
+        return tomllib.loads(path.read_text(encoding="utf-8"))
+    except tomllib.TOMLDecodeError as exc:
+        raise CaseError([f"not valid TOML: {exc}"], path) from None
+
+
 def case_from_dict(data: dict[str, Any], source: Path | str | None = None) -> Case:
     """Validate a case given as nested dictionaries.
 
@@ -444,10 +535,7 @@ def case_from_dict(data: dict[str, Any], source: Path | str | None = None) -> Ca
     CaseError
         Listing every problem, each with field, value and allowed range.
     """
-    try:
-        return Case.model_validate(data)
-    except ValidationError as exc:
-        raise CaseError(_merge_problems([dict(e) for e in exc.errors()]), source) from None
+    return validate_model(Case, data, source)
 
 
 def load_case(path: Path | str) -> Case:
@@ -458,14 +546,7 @@ def load_case(path: Path | str) -> Case:
     CaseError
         When the file is missing, is not valid TOML, or has invalid values.
     """
-    path = Path(path)
-    if not path.is_file():
-        raise CaseError([f"case file {path}: not found"], path)
-    try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
-    except tomllib.TOMLDecodeError as exc:
-        raise CaseError([f"not valid TOML: {exc}"], path) from None
-    return case_from_dict(data, source=path)
+    return case_from_dict(read_toml(path), source=path)
 
 
 def case_to_toml(case: Case) -> str:

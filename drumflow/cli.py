@@ -1,7 +1,9 @@
 """The drumflow command line: the only place that prints or exits.
 
-Exit codes: 0 success, 1 a run failed (solver error, lost particles), 2 bad input (case file,
-arguments, run directory), 130 interrupted (rerun the same command to resume).
+Exit codes, one rule for every command (:func:`drumflow.errors.exit_code`, applied by
+:func:`drumflow.cli_guard.guard_every_command` at the end of this module): 0 success, 1 a run
+failed (solver error, lost particles), 2 bad input (case file, arguments, run directory), 130
+interrupted (rerun the same command to resume).
 """
 
 from __future__ import annotations
@@ -10,7 +12,7 @@ import json
 import sys
 import time
 from pathlib import Path
-from typing import Annotated, Optional
+from typing import Annotated, Any
 
 import typer
 from rich.console import Console
@@ -24,7 +26,12 @@ from rich.progress import (
 )
 from rich.table import Table
 
-from drumflow.errors import CaseError, DrumflowError, LostParticlesError, RunDirectoryError
+from drumflow.cli_cooler import app as cooler_app
+from drumflow.cli_cooler.drum import drum as plant
+from drumflow.cli_export import export
+from drumflow.cli_guard import guard_every_command
+from drumflow.cli_paper import paper
+from drumflow.cli_sweep import sweep
 
 app = typer.Typer(
     add_completion=False,
@@ -34,14 +41,15 @@ app = typer.Typer(
 )
 console = Console()
 err_console = Console(stderr=True)
+app.add_typer(cooler_app, name="cooler")
+app.command("sweep")(sweep)
+app.command("paper")(paper)
+app.command("export")(export)
+# `drumflow plant RUN_DIR` is `drumflow cooler drum RUN_DIR`: the whole cooler from a slice.
+app.command("plant")(plant)
 
 
-def _fail(exc: BaseException, code: int) -> None:
-    err_console.print(f"[bold red]error:[/] {exc}", highlight=False)
-    raise typer.Exit(code)
-
-
-def _load(case_file: Path):  # type: ignore[no-untyped-def]
+def _load(case_file: Path) -> Any:
     from drumflow.case import load_case
 
     return load_case(case_file)
@@ -50,16 +58,12 @@ def _load(case_file: Path):  # type: ignore[no-untyped-def]
 @app.command()
 def check(case_file: Annotated[Path, typer.Argument(help="case file (TOML)")]) -> None:
     """Validate a case file without running anything."""
-    try:
-        case = _load(case_file)
-        from drumflow.dem.timestep import choose_time_step
-        from drumflow.pipeline import refuse_unavailable
+    from drumflow.dem.timestep import choose_time_step
+    from drumflow.pipeline import refuse_unavailable
 
-        refuse_unavailable(case)
-        choice = choose_time_step(case)
-    except CaseError as exc:
-        _fail(exc, 2)
-        return
+    case = _load(case_file)
+    refuse_unavailable(case)
+    choice = choose_time_step(case)
     table = Table(title=f"case {case.name}: valid", show_header=False)
     table.add_row("drum", f"D {case.drum.diameter:g} m, l {case.drum.length:g} m, {case.drum.rpm:g} rpm, "
                   f"tilt {case.drum.tilt_deg:g}°, Froude {case.drum.froude:.3f}")
@@ -67,7 +71,8 @@ def check(case_file: Annotated[Path, typer.Argument(help="case file (TOML)")]) -
     table.add_row("particles", f"{case.particle_count:,} × {case.particles.diameter * 1e3:g} mm, "
                   f"{case.particle_mass_total:.4g} kg")
     table.add_row("time step", f"{choice.time_step:.3g} s ({choice.mode}; {choice.fraction_of_rayleigh:.0%} "
-                  f"of Rayleigh {choice.rayleigh_time:.3g} s; {choice.steps_per_contact:.0f} steps per contact)")
+                  f"of Rayleigh {choice.rayleigh_time:.3g} s; "
+                  f"{choice.steps_per_contact:.0f} steps per contact)")
     table.add_row("steps", f"{round(case.run.time / choice.time_step):,} for {case.run.time:g} s")
     console.print(table)
 
@@ -75,21 +80,19 @@ def check(case_file: Annotated[Path, typer.Argument(help="case file (TOML)")]) -
 @app.command()
 def run(
     case_file: Annotated[Path, typer.Argument(help="case file (TOML)")],
-    out: Annotated[Optional[Path], typer.Option("--out", "-o", help="run directory")] = None,
-    np_: Annotated[Optional[int], typer.Option("--np", min=1, help="MPI processes")] = None,
-    steps: Annotated[Optional[int], typer.Option("--steps", min=1, help="short run: only this many DEM steps")] = None,
-    timeout: Annotated[Optional[float], typer.Option("--timeout", min=1, help="solver time limit, s")] = None,
+    out: Annotated[Path | None, typer.Option("--out", "-o", help="run directory")] = None,
+    np_: Annotated[int | None, typer.Option("--np", min=1, help="MPI processes")] = None,
+    steps: Annotated[
+        int | None, typer.Option("--steps", min=1, help="short run: only this many DEM steps")
+    ] = None,
+    timeout: Annotated[float | None, typer.Option("--timeout", min=1, help="solver time limit, s")] = None,
     force: Annotated[bool, typer.Option("--force", help="reuse a directory of another case")] = False,
     as_json: Annotated[bool, typer.Option("--json", help="print the summary as JSON")] = False,
 ) -> None:
     """Run a case end to end (geometry, DEM, observables, plots) into a run directory."""
     from drumflow.pipeline import run_case
 
-    try:
-        case = _load(case_file)
-    except CaseError as exc:
-        _fail(exc, 2)
-        return
+    case = _load(case_file)
     out = out or Path("runs") / case.name
     columns = (
         TextColumn("[bold]{task.description}"),
@@ -104,25 +107,20 @@ def run(
             tasks: dict[str, TaskID] = {}
 
             def progress(stage: str, done: float, total: float) -> None:
+                # One bar per stage; a stage may change its total (the air stage ends with
+                # (1, 1) when it converges before air.max_iterations), so the bar finishes.
                 if stage not in tasks:
                     tasks[stage] = bar.add_task(stage, total=total, sim="")
                 sim = f"{done:.3f}/{total:.3f} s simulated" if stage == "dem" else ""
-                bar.update(tasks[stage], completed=done, sim=sim)
+                bar.update(tasks[stage], completed=done, total=total, sim=sim)
+                if done >= total:
+                    bar.stop_task(tasks[stage])
 
             summary = run_case(case, out, processes=np_, steps=steps, timeout=timeout,
                                progress=progress, force=force)
-    except (CaseError, RunDirectoryError) as exc:
-        _fail(exc, 2)
-        return
-    except LostParticlesError as exc:
-        _fail(exc, 1)
-        return
-    except DrumflowError as exc:
-        _fail(exc, 1)
-        return
     except KeyboardInterrupt:
-        err_console.print(f"interrupted; run the same command again to resume into {out}")
-        raise typer.Exit(130) from None
+        err_console.print(f"run the same command again to resume into {out}")
+        raise
     _print_summary(summary, out, as_json)
     if summary.get("status", "ok") != "ok":
         err_console.print(f"[bold red]{summary['status']}[/] (see {out}/summary.json)")
@@ -159,11 +157,7 @@ def post(
     """Recompute observables and plots from a run directory's saved dumps (no solver)."""
     from drumflow.pipeline import post_run
 
-    try:
-        summary = post_run(run_dir)
-    except DrumflowError as exc:
-        _fail(exc, 2)
-        return
+    summary = post_run(run_dir)
     _print_summary(summary, run_dir, as_json)
 
 
@@ -185,11 +179,13 @@ def _exchanger_rows(table: Table, r, label_suffix: str = "") -> None:  # type: i
 
 @app.command()
 def exchanger(
-    case_file: Annotated[Path, typer.Argument(help="case file (TOML); its plant and air sections give the streams")],
+    case_file: Annotated[
+        Path, typer.Argument(help="case file (TOML); its plant and air sections give the streams")
+    ],
     h: Annotated[float, typer.Option("--h", help="heat-transfer coefficient, W/(m² K)")],
-    area: Annotated[Optional[float], typer.Option("--area", help="exchange area A_he, m²: solve T_mo")] = None,
+    area: Annotated[float | None, typer.Option("--area", help="exchange area A_he, m²: solve T_mo")] = None,
     outlet_temperature: Annotated[
-        Optional[float],
+        float | None,
         typer.Option("--outlet-temperature", help="material outlet T_mo, °C: solve A_he "
                      "(default: plant.material_outlet_temperature_C when --area is not given)"),
     ] = None,
@@ -199,24 +195,20 @@ def exchanger(
     from drumflow.analysis.exchanger import counter_current_exchanger
     from drumflow.analysis.methodology import exchanger_to_dict, plant_streams
 
-    try:
-        case = _load(case_file)
-        if area is not None and outlet_temperature is not None:
-            raise typer.BadParameter("give --area or --outlet-temperature, not both")
-        if area is None and outlet_temperature is None:
-            outlet_temperature = case.plant.material_outlet_temperature_C
-            if outlet_temperature is None:
-                raise typer.BadParameter(
-                    "give --area A (solve T_mo) or --outlet-temperature T (solve A_he), or set "
-                    "plant.material_outlet_temperature_C in the case"
-                )
-        result = counter_current_exchanger(
-            h_w_m2k=h, area_m2=area, material_outlet_temperature_c=outlet_temperature,
-            **plant_streams(case),
-        )
-    except (DrumflowError, typer.BadParameter) as exc:
-        _fail(exc, 2)
-        return
+    case = _load(case_file)
+    if area is not None and outlet_temperature is not None:
+        raise typer.BadParameter("give --area or --outlet-temperature, not both")
+    if area is None and outlet_temperature is None:
+        outlet_temperature = case.plant.material_outlet_temperature_C
+        if outlet_temperature is None:
+            raise typer.BadParameter(
+                "give --area A (solve T_mo) or --outlet-temperature T (solve A_he), or set "
+                "plant.material_outlet_temperature_C in the case"
+            )
+    result = counter_current_exchanger(
+        h_w_m2k=h, area_m2=area, material_outlet_temperature_c=outlet_temperature,
+        **plant_streams(case),
+    )
     if as_json:
         console.print_json(json.dumps({"case": case.name, **exchanger_to_dict(result)}))
         return
@@ -229,45 +221,45 @@ def exchanger(
 @app.command()
 def predict(
     run_dir: Annotated[Path, typer.Argument(help="reference run directory (a run of the case, with air)")],
-    h: Annotated[Optional[float], typer.Option("--h", help="fixed h, W/(m² K) (default: the run's mean h)")] = None,
+    h: Annotated[
+        float | None, typer.Option("--h", help="fixed h, W/(m² K) (default: the run's mean h)")
+    ] = None,
     fit_with: Annotated[
-        Optional[list[Path]],
+        list[Path] | None,
         typer.Option("--fit-with", help="more run directories: fit Nu = a Re^b Pr^c to all runs "
                      "and use it instead of a fixed h (repeat the option)"),
     ] = None,
-    rpm: Annotated[Optional[float], typer.Option("--rpm", help="new rotation speed, 1/min")] = None,
-    air_flow: Annotated[Optional[float], typer.Option("--air-flow", help="new air mass flow, kg/s")] = None,
-    feed_rate: Annotated[Optional[float], typer.Option("--feed-rate", help="new feed rate, kg/s")] = None,
+    rpm: Annotated[float | None, typer.Option("--rpm", help="new rotation speed, 1/min")] = None,
+    air_flow: Annotated[float | None, typer.Option("--air-flow", help="new air mass flow, kg/s")] = None,
+    feed_rate: Annotated[float | None, typer.Option("--feed-rate", help="new feed rate, kg/s")] = None,
     particle_diameter: Annotated[
-        Optional[float], typer.Option("--particle-diameter", help="new particle diameter, m")
+        float | None, typer.Option("--particle-diameter", help="new particle diameter, m")
     ] = None,
     conductivity: Annotated[
         str, typer.Option("--conductivity", help="k in Nu = h Dp / k: 'air' or 'particle' (the paper's)")
     ] = "air",
-    assumptions: Annotated[bool, typer.Option("--assumptions", help="also print the scaling assumptions")] = False,
+    assumptions: Annotated[
+        bool, typer.Option("--assumptions", help="also print the scaling assumptions")
+    ] = False,
     as_json: Annotated[bool, typer.Option("--json", help="print the prediction as JSON")] = False,
 ) -> None:
     """Predict the plant outlet temperatures at a new rpm, air flow, feed rate or particle size."""
     from drumflow.analysis.methodology import analyse_run, fit_runs
     from drumflow.analysis.predict import predict_plant
 
-    try:
-        reference = analyse_run(run_dir, nusselt_conductivity=conductivity)  # type: ignore[arg-type]
-        if fit_with and h is not None:
-            raise typer.BadParameter("give --h or --fit-with, not both")
-        source = (
-            fit_runs([reference, *fit_with], nusselt_conductivity=conductivity)  # type: ignore[arg-type]
-            if fit_with
-            else (reference.h_mean_w_m2k if h is None else h)
-        )
-        pred = predict_plant(
-            source, reference.case, reference=reference, rpm=rpm, air_mass_flow=air_flow,
-            feed_rate=feed_rate, particle_diameter=particle_diameter,
-            nusselt_conductivity=conductivity,  # type: ignore[arg-type]
-        )
-    except (DrumflowError, typer.BadParameter) as exc:
-        _fail(exc, 2)
-        return
+    if fit_with and h is not None:
+        raise typer.BadParameter("give --h or --fit-with, not both")
+    reference = analyse_run(run_dir, nusselt_conductivity=conductivity)  # type: ignore[arg-type]
+    source = (
+        fit_runs([reference, *fit_with], nusselt_conductivity=conductivity)  # type: ignore[arg-type]
+        if fit_with
+        else (reference.h_mean_w_m2k if h is None else h)
+    )
+    pred = predict_plant(
+        source, reference.case, reference=reference, rpm=rpm, air_mass_flow=air_flow,
+        feed_rate=feed_rate, particle_diameter=particle_diameter,
+        nusselt_conductivity=conductivity,  # type: ignore[arg-type]
+    )
     if as_json:
         console.print_json(json.dumps(pred.to_dict()))
         return
@@ -285,7 +277,8 @@ def predict(
         ("Re", pred.reference_reynolds, pred.reynolds, "{:.5g}"),
         ("h (W/(m² K))", pred.reference_h_w_m2k, pred.h_w_m2k, "{:.4g}"),
         ("area A_he (m²)", pred.reference_exchanger_area_m2, pred.exchanger_area_m2, "{:.2f}"),
-        ("material outlet T_mo (°C)", ex0.material_outlet_temperature_c, ex1.material_outlet_temperature_c, "{:.2f}"),
+        ("material outlet T_mo (°C)", ex0.material_outlet_temperature_c,
+         ex1.material_outlet_temperature_c, "{:.2f}"),
         ("air outlet T_ao (°C)", ex0.air_outlet_temperature_c, ex1.air_outlet_temperature_c, "{:.2f}"),
         ("thermal power Q_m (kW)", ex0.heat_removed_w / 1e3, ex1.heat_removed_w / 1e3, "{:.2f}"),
     ]:
@@ -305,18 +298,16 @@ def report(
     conductivity: Annotated[
         str, typer.Option("--conductivity", help="k in Nu = h Dp / k: 'air' or 'particle' (the paper's)")
     ] = "air",
-    render_3d: Annotated[bool, typer.Option("--3d/--no-3d", help="PyVista picture of the last snapshot")] = True,
+    render_3d: Annotated[
+        bool, typer.Option("--3d/--no-3d", help="PyVista picture of the last snapshot")
+    ] = True,
     as_json: Annotated[bool, typer.Option("--json", help="print the report path as JSON")] = False,
 ) -> None:
     """One self-contained HTML page: case, Tables 6-8, Figures 4, 6-9, manifest."""
     from drumflow.report.html import write_report
 
-    try:
-        path = write_report(run_dirs, out, nusselt_conductivity=conductivity,  # type: ignore[arg-type]
-                            render_3d=render_3d)
-    except DrumflowError as exc:
-        _fail(exc, 2)
-        return
+    path = write_report(run_dirs, out, nusselt_conductivity=conductivity,  # type: ignore[arg-type]
+                        render_3d=render_3d)
     if as_json:
         console.print_json(json.dumps({"report": str(path), "runs": [str(p) for p in run_dirs]}))
         return
@@ -337,13 +328,9 @@ def methodology(
     """Heat-transfer coefficient, Nu/Re/Pr and the exchanger model of one run (Tables 6-7)."""
     from drumflow.analysis.methodology import analyse_run, write_methodology
 
-    try:
-        result = analyse_run(run_dir, nusselt_conductivity=conductivity,  # type: ignore[arg-type]
-                             falling_mass=falling_mass)  # type: ignore[arg-type]
-        json_path, csv_path = write_methodology(run_dir, result)
-    except DrumflowError as exc:
-        _fail(exc, 2)
-        return
+    result = analyse_run(run_dir, nusselt_conductivity=conductivity,  # type: ignore[arg-type]
+                         falling_mass=falling_mass)  # type: ignore[arg-type]
+    json_path, csv_path = write_methodology(run_dir, result)
     if as_json:
         console.print_json(json.dumps(result.to_dict()))
         return
@@ -366,7 +353,9 @@ def methodology(
 @app.command()
 def verify(
     quick: Annotated[bool, typer.Option("--quick", help="only what fits in a couple of minutes")] = False,
-    out: Annotated[Path, typer.Option("--out", "-o", help="where the cases and verification.json go")] = Path("runs/verify"),
+    out: Annotated[
+        Path, typer.Option("--out", "-o", help="where the cases and verification.json go")
+    ] = Path("runs/verify"),
 ) -> None:
     """Run the verification cases (analytic solutions, conservation laws) on the real solvers."""
     from drumflow.verify import run_verification
@@ -377,15 +366,12 @@ def verify(
 
     def show(c) -> None:  # type: ignore[no-untyped-def]
         mark = "[green]pass[/]" if c.passed else "[bold red]FAIL[/]"
-        err_console.print(f"{mark} {c.name}: error {c.error:.3g} (tolerance {c.tolerance:.3g})", highlight=False)
+        err_console.print(f"{mark} {c.name}: error {c.error:.3g} (tolerance {c.tolerance:.3g})",
+                          highlight=False)
         table.add_row(c.name, f"{c.measured:.6g} {c.unit}", f"{c.expected:.6g}", f"{c.error:.3g}",
                       f"{c.tolerance:.3g}", mark)
 
-    try:
-        checks = run_verification(out, quick=quick, on_check=show)
-    except DrumflowError as exc:
-        _fail(exc, 1)
-        return
+    checks = run_verification(out, quick=quick, on_check=show)
     console.print(table)
     console.print(f"written: {out / 'verification.json'}", highlight=False)
     if not all(c.passed for c in checks):
@@ -395,30 +381,38 @@ def verify(
 @app.command()
 def bench(
     case_file: Annotated[Path, typer.Argument(help="reference scene: a case file (TOML)")],
-    out: Annotated[Optional[Path], typer.Option("--out", "-o", help="bench directory")] = None,
-    rungs: Annotated[Optional[str], typer.Option("--rungs", help="comma-separated rung names (default: all)")] = None,
-    time_s: Annotated[Optional[float], typer.Option("--time", min=0.01, help="simulated time per rung, s (default: the case's)")] = None,
-    timeout: Annotated[Optional[float], typer.Option("--timeout", min=1, help="solver time limit per rung, s")] = None,
+    out: Annotated[Path | None, typer.Option("--out", "-o", help="bench directory")] = None,
+    rungs: Annotated[
+        str | None, typer.Option("--rungs", help="comma-separated rung names (default: all)")
+    ] = None,
+    time_s: Annotated[
+        float | None,
+        typer.Option("--time", min=0.01, help="simulated time per rung, s (default: the case's)"),
+    ] = None,
+    timeout: Annotated[
+        float | None, typer.Option("--timeout", min=1, help="solver time limit per rung, s")
+    ] = None,
     list_only: Annotated[bool, typer.Option("--list", help="list the rungs and exit")] = False,
-    speed_only: Annotated[bool, typer.Option("--speed-only", help="no reference rung: run times only")] = False,
+    speed_only: Annotated[
+        bool, typer.Option("--speed-only", help="no reference rung: run times only")
+    ] = False,
 ) -> None:
     """Run time against error: a ladder of settings on one scene -> results.csv and pareto.png."""
     from drumflow.bench import run_bench
     from drumflow.bench.ladder import ladder, select
     from drumflow.case import case_from_dict
 
+    case = _load(case_file)
+    if time_s is not None:
+        data = case.model_dump(mode="json")
+        data["run"]["time"] = time_s
+        data["run"]["mass_flow_start"] = min(case.run.mass_flow_start, 0.5 * time_s)
+        case = case_from_dict(data, source=case_file)
+    names = [n.strip() for n in rungs.split(",") if n.strip()] if rungs else None
     try:
-        case = _load(case_file)
-        if time_s is not None:
-            data = case.model_dump(mode="json")
-            data["run"]["time"] = time_s
-            data["run"]["mass_flow_start"] = min(case.run.mass_flow_start, 0.5 * time_s)
-            case = case_from_dict(data, source=case_file)
-        names = [n.strip() for n in rungs.split(",") if n.strip()] if rungs else None
         chosen = select(ladder(case), names, speed_only)
-    except (CaseError, ValueError) as exc:
-        _fail(exc, 2)
-        return
+    except ValueError as exc:  # an unknown rung name: bad input, exit 2 through click
+        raise typer.BadParameter(str(exc), param_hint="--rungs") from None
     if list_only:
         for r in chosen:
             console.print(f"{r.name:18s} {r.group:12s} {r.description}", highlight=False)
@@ -436,12 +430,9 @@ def bench(
 
     try:
         result = run_bench(case, out, names, timeout=timeout, on_rung=on_rung, speed_only=speed_only)
-    except DrumflowError as exc:
-        _fail(exc, 1)
-        return
     except KeyboardInterrupt:
-        err_console.print(f"interrupted; run the same command again to resume into {out}")
-        raise typer.Exit(130) from None
+        err_console.print(f"run the same command again to resume into {out}")
+        raise
     table = Table(title=f"drumflow bench {case.name} → {out}")
     cols = [("rung", "rung", "{}"), ("dt/t_R", "fraction_of_rayleigh", "{:.2f}"),
             ("DEM s", "dem_wall_time_s", "{:.1f}"), ("speed-up", "speedup_vs_conservative", "{:.2f}"),
@@ -457,13 +448,22 @@ def bench(
         table.add_row(*cells)
     console.print(table)
     console.print(f"written: {result.csv}, {result.json}, {result.plot}", highlight=False)
+    failed = [str(r["rung"]) for _, r in result.table.iterrows() if str(r["status"]).startswith("failed")]
+    if failed:
+        # A rung whose run failed is a failed run (exit 1), even though the table was written.
+        err_console.print(f"[bold red]failed rung(s):[/] {', '.join(failed)}", highlight=False)
+        raise typer.Exit(1)
+
+
+# Last, after every command (and the groups above) is registered: one wrapper for all.
+guard_every_command(app)
 
 
 def main() -> None:
     """Console-script entry point."""
     try:
         app()
-    except KeyboardInterrupt:
+    except KeyboardInterrupt:  # Ctrl-C outside a command (while parsing arguments)
         sys.exit(130)
 
 

@@ -10,6 +10,10 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from drumflow.air.foam_results import AirSolution
 
 
 class DrumflowError(Exception):
@@ -136,6 +140,53 @@ class UnstableRunError(SolverError):
         super().__init__("liggghts", command, None, log, reason=f"run stopped: {diagnosis}")
 
 
+class AirNotConvergedError(SolverError):
+    """simpleFoam reached ``air.max_iterations`` before every residual fell below the target.
+
+    Attributes
+    ----------
+    iterations
+        SIMPLE iterations run.
+    final_residuals
+        The last initial residual of each field.
+    target
+        The residual target that was not reached.
+    solution
+        The (unconverged) :class:`~drumflow.air.foam_results.AirSolution`, whose files are left
+        in place; a caller may
+        still decide to use it.
+    """
+
+    def __init__(
+        self,
+        iterations: int,
+        final_residuals: dict[str, float],
+        target: float,
+        log: Path | None,
+        solution: AirSolution | None = None,
+    ) -> None:
+        self.iterations = iterations
+        self.final_residuals = dict(final_residuals)
+        self.target = target
+        self.solution = solution
+        worst = max(final_residuals.items(), key=lambda kv: kv[1], default=("?", float("nan")))
+        super().__init__(
+            "simpleFoam",
+            ["simpleFoam"],
+            0,
+            log,
+            reason=(
+                f"the air solution did not converge in {iterations} SIMPLE iterations: "
+                f"{worst[0]} residual {worst[1]:.3g} > target {target:.3g} "
+                "(raise air.max_iterations, coarsen air.mesh_size or relax air.residual_target)"
+            ),
+        )
+
+
+class MeshCheckError(SolverError):
+    """``checkMesh`` reported failed checks: the mesh would give a wrong or diverging air field."""
+
+
 class InsertionError(DrumflowError, RuntimeError):
     """Fewer particles could be placed in the drum than the case asks for."""
 
@@ -148,3 +199,97 @@ class InsertionError(DrumflowError, RuntimeError):
 
 class RunDirectoryError(DrumflowError, ValueError):
     """A run directory is missing what a stage needs, or belongs to a different case."""
+
+
+class AnalysisInputError(DrumflowError, ValueError):
+    """An argument of an analysis function is outside its allowed range.
+
+    It subclasses :class:`ValueError` so callers that do not know drumflow can still catch it,
+    and :class:`DrumflowError` so the CLI reports it as a drumflow error.
+
+    Parameters
+    ----------
+    name
+        Name of the argument (as in the function signature, with an index for array items).
+    value
+        The rejected value (already formatted or any object; it is shown with ``repr``).
+    allowed
+        Human-readable description of the accepted values, e.g. ``"a finite number > 0"``.
+    """
+
+    def __init__(self, name: str, value: object, allowed: str) -> None:
+        self.name = name
+        self.value = value
+        self.allowed = allowed
+        super().__init__(f"{name} = {_show(value)} is not allowed: expected {allowed}")
+
+
+def _show(value: object) -> str:
+    # numpy scalars print as np.float64(1.0) with repr; convert to plain Python first so
+    # messages read the same whatever the caller passed. Duck-typed so this module stays free
+    # of numpy (it is imported by everything).
+    item = getattr(value, "item", None)
+    if type(value).__module__ == "numpy" and callable(item) and getattr(value, "ndim", 1) == 0:
+        value = item()
+    if isinstance(value, float):
+        return f"{value:.6g}"
+    if isinstance(value, str):
+        return value
+    return repr(value)
+
+
+class InfeasibleExchangerError(AnalysisInputError):
+    """The requested operating point violates the second law (e.g. a temperature cross)."""
+
+
+class MissingRunFileError(RunDirectoryError):
+    """A file the methodology needs is not in the run directory.
+
+    Parameters
+    ----------
+    path
+        The missing file (absolute).
+    what
+        What the file holds, for the message.
+
+    Attributes
+    ----------
+    path
+        The missing file.
+    """
+
+    def __init__(self, path: Path, what: str) -> None:
+        self.path = path
+        super().__init__(
+            f"{path}: missing ({what}); run `drumflow run CASE --out DIR` (or `drumflow post DIR` "
+            "if the dumps are there) first"
+        )
+
+
+class NoHeatTransferError(RunDirectoryError):
+    """The run cannot give a heat-transfer coefficient (no air, no cooling, no falling mass)."""
+
+
+class RenderError(DrumflowError, RuntimeError):
+    """The particle picture could not be rendered (no OpenGL, crash, time limit, bad data)."""
+
+
+#: Exit codes of every drumflow command, computed once from the error's class by :func:`exit_code`.
+EXIT_OK = 0
+EXIT_FAILED = 1
+EXIT_BAD_INPUT = 2
+EXIT_INTERRUPTED = 130
+
+
+def exit_code(exc: BaseException) -> int:
+    """The one exit-code rule: bad input 2, a failed run 1, interrupted 130.
+
+    Bad input is every drumflow error that is also a ``ValueError`` (a case or sweep file, an
+    argument, a run directory); every other drumflow error is a run that failed. Anything
+    else is a bug and also maps to 1 (the CLI shows its traceback).
+    """
+    if isinstance(exc, KeyboardInterrupt):
+        return EXIT_INTERRUPTED
+    if isinstance(exc, DrumflowError) and isinstance(exc, ValueError):
+        return EXIT_BAD_INPUT
+    return EXIT_FAILED

@@ -1,4 +1,4 @@
-"""The pipeline: case -> geometry -> DEM -> (air) -> observables -> summary and plots.
+"""The pipeline: case -> geometry -> air -> coupling spec -> DEM -> observables -> summary and plots.
 
 :func:`run_case` runs every stage into a run directory, skipping finished ones;
 :func:`post_run` recomputes the observables and plots from the saved dumps, with no solver.
@@ -13,7 +13,10 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import pandas as pd
 
+from drumflow import air, dem, geometry
+from drumflow.air.stage import AirInputs
 from drumflow.analysis.observables import (
     crossings_from_rows,
     escaped_particles,
@@ -22,18 +25,23 @@ from drumflow.analysis.observables import (
     mean_temperature,
 )
 from drumflow.case import Case, case_to_toml, load_case
-from drumflow.air import prepare_air
+from drumflow.coupling.crossings import CROSSINGS_RECORD, read_loop_crossings
 from drumflow.coupling.log import read_coupling
-from drumflow.dem import ProgressCallback, run_dem
-from drumflow.dem.deck import plan_steps
-from drumflow.dem.timestep import choose_time_step
+from drumflow.coupling.spec import CouplingSpec, build_coupling
+from drumflow.coupling.stop import STOP_RECORD
 from drumflow.dem.dumps import read_rows, read_series
+from drumflow.dem.stage import DemInputs, DemResult, ProgressCallback, plan_run
 from drumflow.dem.thermo import read_thermo
 from drumflow.errors import CaseError, RunDirectoryError
-from drumflow.geometry import build_geometry
-from drumflow.report.plots import plot_air_heat, plot_crossings, plot_mean_temperature, plot_particles
+from drumflow.report.plots import (
+    plot_air_heat,
+    plot_crossings,
+    plot_mean_temperature,
+    plot_particles,
+)
 from drumflow.rundir import RunDir
 from drumflow.runner import LaunchProfile, Runner
+from drumflow.skips import skips
 
 __all__ = ["run_case", "post_run", "refuse_unavailable"]
 
@@ -85,42 +93,61 @@ def run_case(
         data["run"]["processes"] = processes
         case = Case.model_validate(data)
     refuse_unavailable(case)
-    rundir = RunDir(out)
-    rundir.bind_case(case.canonical_json(), case.hash(), case_to_toml(case), force=force)
     runner = Runner(profile)
+    rundir = RunDir(out)
+    rundir.bind_case(case.canonical_json(), case.hash(), case_to_toml(case), force=force,
+                     versions=runner.profile.software_versions())
     t0 = time.perf_counter()
-    geometry = build_geometry(case, rundir)
+    shape = geometry.run(case, rundir, runner)
     if progress:
         progress("geometry", 1.0, 1.0)
-    plan = plan_steps(case, choose_time_step(case))
+    # The one choice of the time step and the processes: the air coupling and the DEM stage
+    # both use them.
+    choice, plan = plan_run(case, steps)
+    nprocs = runner.profile.processes_for(case)
+    coupling = _air(case, rundir, runner, nprocs, plan.time_step, plan.dump_every, progress)
+    rundir.record("skips", skips(case, choice.mode, coupling is not None, shape.wall_motion, nprocs))
+    inputs = DemInputs(shape, choice, plan, processes=nprocs, coupling=coupling, steps=steps,
+                       timeout=timeout, progress=progress)
+    result = dem.run(case, rundir, runner, inputs)
+    if steps is not None:
+        return _short_run_summary(case, rundir, result, steps, t0)
+    summary = post_run(rundir.root, case=case)
+    summary["wall_time_s"] = time.perf_counter() - t0
+    summary["dem_wall_time_s"] = result.wall_time_s
+    summary["particle_steps_per_s"] = result.particle_steps_per_s
+    rundir.summary_path.write_text(json.dumps(summary, indent=2))
+    rundir.record("summary", summary)
+    return summary
+
+
+def _air(case: Case, rundir: RunDir, runner: Runner, processes: int, time_step: float,
+         dump_every: int, progress: ProgressCallback | None) -> CouplingSpec | None:
+    """The air stage's field and the coupling spec built from it (``None`` without air)."""
     try:
-        air = prepare_air(case, rundir, runner, plan.time_step, plan.dump_every, progress)
+        field = air.run(case, rundir, runner, AirInputs(processes=processes, progress=progress))
     finally:
         # Every OpenFOAM program run (or failed) goes into the manifest with its timing.
         rundir.record_commands([r.as_dict() for r in runner.records])
-    if air is not None:
-        rundir.record("air", asdict(air[1]))
-        if progress:
-            progress("air", 1.0, 1.0)
-    dem = run_dem(case, rundir, runner, geometry, progress=progress, steps=steps, timeout=timeout,
-                  air=None if air is None else air[0])
-    if steps is not None:
-        summary = {
-            "case": case.name,
-            "short_run_steps": steps,
-            "particles_initial": dem.particles_initial,
-            "particles_final": dem.particles_final,
-            "wall_time_s": time.perf_counter() - t0,
-            "dem": asdict(dem),
-        }
-        rundir.summary_path.write_text(json.dumps(summary, indent=2))
-        return summary
-    summary = post_run(rundir.root, case=case)
-    summary["wall_time_s"] = time.perf_counter() - t0
-    summary["dem_wall_time_s"] = dem.wall_time_s
-    summary["particle_steps_per_s"] = dem.particle_steps_per_s
+    if field is None:
+        return None
+    coupling = build_coupling(case, field.source, time_step, dump_every)
+    field.summary.coupling_interval_steps = coupling.interval
+    rundir.record("air", field.summary.as_dict())
+    return coupling
+
+
+def _short_run_summary(case: Case, rundir: RunDir, result: DemResult, steps: int,
+                       t0: float) -> dict[str, Any]:
+    summary = {
+        "case": case.name,
+        "short_run_steps": steps,
+        "particles_initial": result.particles_initial,
+        "particles_final": result.particles_final,
+        "wall_time_s": time.perf_counter() - t0,
+        "dem": asdict(result),
+    }
     rundir.summary_path.write_text(json.dumps(summary, indent=2))
-    rundir.record("summary", summary)
     return summary
 
 
@@ -132,26 +159,36 @@ def post_run(out: Path | str, case: Case | None = None) -> dict[str, Any]:
     RunDirectoryError
         When the directory lacks the case or the dumps.
     """
-    root = Path(out).resolve()
-    rundir = RunDir(root)
-    rundir.require("case.toml", "dem/dumps", "dem/log.liggghts")
+    rundir = RunDir.existing(out)
+    root = rundir.root
+    rundir.require(rundir.case_toml, rundir.dem_dumps, rundir.dem_log)
     if case is None:
-        case = load_case(root / "case.toml")
+        case = load_case(rundir.case_toml)
     ts = rundir.manifest.get("time_step", {}).get("time_step")
     if ts is None:
         raise RunDirectoryError(f"{root}/manifest.json: no DEM time step recorded; rerun the case")
     t0 = time.perf_counter()
-    dumps = rundir.dem / "dumps"
+    dumps = rundir.dem_dumps
     thermo = read_thermo(rundir.dem, every=rundir.manifest.get("output_every"))
     if thermo.empty:
         raise RunDirectoryError(f"{rundir.dem}: no LIGGGHTS thermo output (log.liggghts)")
     times = thermo["step"].to_numpy() * float(ts)
     T_mean = thermo["T_mean"].to_numpy()
-    rows = read_rows(dumps, float(ts), prefix="cross")
+    loop_crossings = rundir.dem / CROSSINGS_RECORD
+    # run.crossings = "loop": the coupling loop wrote the crossings themselves; else they come
+    # from the band dump.
+    table = read_loop_crossings(loop_crossings) if loop_crossings.exists() else None
+    rows = None if table is not None else read_rows(dumps, float(ts), prefix="cross")
     snaps = read_series(dumps, float(ts), prefix="snap")
     read_s = time.perf_counter() - t0
     mass = case.particles.mass
-    crossings = crossings_from_rows(rows.times, rows.frame, rows.ids, rows["x"], rows["y"], rows["z"])
+    if table is not None:
+        crossings = pd.DataFrame({"time": table[:, 0], "id": table[:, 1].astype(np.int64),
+                                  "x": table[:, 2], "z": table[:, 3]})
+    else:
+        assert rows is not None
+        crossings = crossings_from_rows(rows.times, rows.frame, rows.ids, rows["x"], rows["y"],
+                                        rows["z"])
     curtain_r = case.drum.radius - case.lifters.base_height
     flow = falling_mass_flow(crossings, mass, start=case.run.mass_flow_start, curtain_radius=curtain_r)
     per_step = falling_mass_per_interval(crossings, times, mass)
@@ -165,9 +202,9 @@ def post_run(out: Path | str, case: Case | None = None) -> dict[str, Any]:
 
     post = rundir.post
     post.mkdir(parents=True, exist_ok=True)
-    crossings.to_csv(post / "crossings.csv", index=False, float_format="%.6g")
+    crossings.to_csv(rundir.crossings_csv, index=False, float_format="%.6g")
     np.savetxt(
-        post / "mean_temperature.csv",
+        rundir.mean_temperature_csv,
         np.column_stack([times, T_mean, thermo["atoms"].to_numpy(), np.r_[np.nan, per_step]]),
         delimiter=",",
         header="time_s,mean_temperature_C,particles,falling_mass_kg_in_step",
@@ -175,10 +212,10 @@ def post_run(out: Path | str, case: Case | None = None) -> dict[str, Any]:
         fmt="%.10g",
     )
     title = f"{case.name}: {case.particle_count:,} particles of {case.particles.diameter * 1e3:g} mm"
-    plot_mean_temperature(times, T_mean, post / "mean_temperature.png", title)
-    plot_crossings(crossings, flow, case.drum.length, post / "crossings.png", title)
+    plot_mean_temperature(times, T_mean, rundir.mean_temperature_plot, title)
+    plot_crossings(crossings, flow, case.drum.length, rundir.crossings_plot, title)
     plot_particles(snaps["x"][-1], snaps["y"][-1], snaps["T"][-1], case,
-                   post / "particles_final.png", f"{title}, t = {snaps.times[-1]:.2f} s",
+                   rundir.particles_plot, f"{title}, t = {snaps.times[-1]:.2f} s",
                    time_s=float(snaps.times[-1]))
 
     air_info = _post_air(rundir, case, float(ts), times, T_mean)
@@ -207,6 +244,7 @@ def post_run(out: Path | str, case: Case | None = None) -> dict[str, Any]:
         "output_steps": int(len(times)),
         "snapshots": int(len(snaps.times)),
         **air_info,
+        **_stop_info(rundir),
         "post_read_s": read_s,
         "post_wall_time_s": time.perf_counter() - t0,
     }
@@ -217,26 +255,40 @@ def post_run(out: Path | str, case: Case | None = None) -> dict[str, Any]:
     return merged
 
 
-def _post_air(rundir: RunDir, case: Case, time_step: float, times: np.ndarray, T_mean: np.ndarray) -> dict[str, Any]:
+def _stop_info(rundir: RunDir) -> dict[str, Any]:
+    """Why and when a 'converged' run stopped, with its intervals (nothing for a fixed run)."""
+    path = rundir.dem / STOP_RECORD
+    if not path.exists():
+        return {}
+    return {"stop": json.loads(path.read_text())}
+
+
+def _post_air(
+    rundir: RunDir,
+    case: Case,
+    time_step: float,
+    times: np.ndarray,
+    T_mean: np.ndarray,
+) -> dict[str, Any]:
     """Heat the air took from the particles, its plot, and the energy balance check."""
-    coupling = read_coupling(rundir.dem / "coupling", time_step)
+    coupling = read_coupling(rundir.dem_coupling_logs, time_step)
     if coupling.empty:
         return {}
-    coupling.to_csv(rundir.post / "air_heat.csv", index=False, float_format="%.10g")
+    coupling.to_csv(rundir.air_heat_csv, index=False, float_format="%.10g")
     removed = float(coupling["heat_removed_J"].iloc[-1])
     # The particles' enthalpy loss, from LIGGGHTS' mass-weighted mean temperature: an
     # independent route to the same number (conduction only moves heat between particles).
     loss = case.particle_mass_total * case.particles.heat_capacity * float(T_mean[0] - T_mean[-1])
     closure = abs(loss - removed) / abs(removed) if removed else float("nan")
-    plot_air_heat(coupling, rundir.post / "air_heat.png", f"{case.name}: heat removed by the air")
-    air = rundir.manifest.get("air", {})
+    plot_air_heat(coupling, rundir.air_heat_plot, f"{case.name}: heat removed by the air")
+    recorded = rundir.manifest.get("air", {})
     return {
         "air_model": case.air.model,
-        "air_mass_flow_in_kg_s": air.get("mass_flow_in_kg_s"),
-        "air_mass_flow_out_kg_s": air.get("mass_flow_out_kg_s"),
-        "air_mean_axial_velocity_m_s": air.get("mean_axial_velocity_m_s"),
-        "air_coupling_interval_steps": air.get("coupling_interval_steps"),
-        "air_field_cache_hit": air.get("cache_hit"),
+        "air_mass_flow_in_kg_s": recorded.get("mass_flow_in_kg_s"),
+        "air_mass_flow_out_kg_s": recorded.get("mass_flow_out_kg_s"),
+        "air_mean_axial_velocity_m_s": recorded.get("mean_axial_velocity_m_s"),
+        "air_coupling_interval_steps": recorded.get("coupling_interval_steps"),
+        "air_field_cache_hit": recorded.get("cache_hit"),
         "heat_removed_by_air_J": removed,
         "particle_enthalpy_loss_J": loss,
         "energy_balance_error": closure,

@@ -6,24 +6,24 @@ Layout of a run directory::
       manifest.json        case, its hash, versions, commands, timings, return codes
       case.toml            the validated case as it was run
       geometry/            walls.stl, geometry.json, cross_section.png
-      dem/                 in.drum, particles.data, log.liggghts, dumps/, restart/
-      post/                crossings.csv, mean_temperature.csv, plots
+      air/                 openfoam/, field.npz, solution.json, air_cross_section.png
+      dem/                 in.drum, particles.data, log.liggghts, coupling.json, dumps/,
+                           restart/, coupling/
+      post/                crossings.csv, mean_temperature.csv, air_heat.csv, methodology.json,
+                           steps.csv, plots
       summary.json         the headline numbers
       stages/<name>.json   one marker per finished stage, with the hash of its inputs
 
-A stage is skipped when its marker holds the same input hash; a different case in the same
-directory is refused rather than mixed with old results.
+:class:`RunDir` owns this layout: every other module asks it for a path rather than joining
+file names itself. A stage is skipped when its marker holds the same input hash; a different
+case in the same directory is refused rather than mixed with old results.
 """
 
 from __future__ import annotations
 
 import hashlib
 import json
-import platform
-import subprocess
-import sys
 import time
-from importlib import metadata
 from pathlib import Path
 from typing import Any
 
@@ -44,38 +44,11 @@ def hash_text(text: str) -> str:
     return hashlib.sha256(text.encode()).hexdigest()
 
 
-def _dpkg_version(package: str) -> str | None:
-    try:
-        out = subprocess.run(
-            ["dpkg-query", "-W", "-f=${Version}", package],
-            capture_output=True,
-            text=True,
-            timeout=10,
-        )
-    except (OSError, subprocess.TimeoutExpired):
-        return None
-    if out.returncode != 0:
-        return None
-    return out.stdout.strip() or None
-
-
 def software_versions() -> dict[str, Any]:
-    """Versions of drumflow, the solvers, Python and the Python packages it uses."""
-    packages: dict[str, str | None] = {}
-    for name in ("drumflow", "numpy", "scipy", "pandas", "gmsh", "meshio", "pyvista", "pydantic",
-                 "jinja2", "foamlib", "matplotlib", "typer", "rich"):
-        try:
-            packages[name] = metadata.version(name)
-        except metadata.PackageNotFoundError:
-            packages[name] = None
-    return {
-        "python": sys.version.split()[0],
-        "platform": platform.platform(),
-        "liggghts": _dpkg_version("liggghts"),
-        "openfoam": _dpkg_version("openfoam"),
-        "openmpi": _dpkg_version("openmpi-bin"),
-        "packages": packages,
-    }
+    """Versions of drumflow, the solvers, Python and its packages (the launch profile's lookup)."""
+    from drumflow.runner import LaunchProfile
+
+    return LaunchProfile().software_versions()
 
 
 class RunDir:
@@ -87,38 +60,161 @@ class RunDir:
         The directory (created if missing).
     """
 
-    def __init__(self, root: Path | str) -> None:
+    def __init__(self, root: Path | str, create: bool = True) -> None:
         self.root = Path(root).resolve()
-        self.root.mkdir(parents=True, exist_ok=True)
+        if create:
+            self.root.mkdir(parents=True, exist_ok=True)
         self.manifest_path = self.root / "manifest.json"
         self.manifest: dict[str, Any] = (
             json.loads(self.manifest_path.read_text()) if self.manifest_path.exists() else {}
         )
 
+    @classmethod
+    def existing(cls, root: Path | str) -> RunDir:
+        """Open a run directory to read it; never creates anything.
+
+        Raises
+        ------
+        RunDirectoryError
+            If ``root`` is not a directory written by ``drumflow run`` (no case file and no
+            manifest).
+        """
+        path = Path(root).resolve()
+        if not path.is_dir():
+            raise RunDirectoryError(f"{path}: not a directory (expected a `drumflow run` directory)")
+        rundir = cls(path, create=False)
+        if not rundir.case_toml.exists() and not rundir.manifest_path.exists():
+            raise RunDirectoryError(
+                f"{path}: not a `drumflow run` directory (no case.toml and no manifest.json)"
+            )
+        return rundir
+
     # -- paths -------------------------------------------------------------------------
     @property
-    def geometry(self) -> Path:
-        return self.root / "geometry"
+    def case_toml(self) -> Path:
+        """The validated case as it was run."""
+        return self.root / "case.toml"
 
     @property
-    def dem(self) -> Path:
-        return self.root / "dem"
+    def summary_path(self) -> Path:
+        return self.root / "summary.json"
 
     @property
-    def post(self) -> Path:
-        return self.root / "post"
+    def stages(self) -> Path:
+        return self.root / "stages"
 
     @property
     def logs(self) -> Path:
         return self.root / "logs"
 
     @property
-    def summary_path(self) -> Path:
-        return self.root / "summary.json"
+    def geometry(self) -> Path:
+        return self.root / "geometry"
+
+    @property
+    def geometry_json(self) -> Path:
+        return self.geometry / "geometry.json"
+
+    @property
+    def geometry_picture(self) -> Path:
+        return self.geometry / "cross_section.png"
+
+    @property
+    def air(self) -> Path:
+        return self.root / "air"
+
+    @property
+    def air_openfoam(self) -> Path:
+        """The OpenFOAM case of the air stage (when it was solved here, not taken from cache)."""
+        return self.air / "openfoam"
+
+    @property
+    def air_field(self) -> Path:
+        return self.air / "field.npz"
+
+    @property
+    def air_solution(self) -> Path:
+        return self.air / "solution.json"
+
+    @property
+    def air_picture(self) -> Path:
+        return self.air / "air_cross_section.png"
+
+    @property
+    def dem(self) -> Path:
+        return self.root / "dem"
+
+    @property
+    def dem_dumps(self) -> Path:
+        return self.dem / "dumps"
+
+    @property
+    def dem_restart(self) -> Path:
+        return self.dem / "restart"
+
+    @property
+    def dem_coupling_logs(self) -> Path:
+        """Per-rank logs of the coupling loop."""
+        return self.dem / "coupling"
+
+    @property
+    def dem_log(self) -> Path:
+        """LIGGGHTS' own log of the first (not resumed) DEM run."""
+        return self.dem / "log.liggghts"
+
+    def dem_logs(self) -> list[Path]:
+        """LIGGGHTS' own logs of the DEM run and every resume."""
+        return sorted(self.dem.glob("log*.liggghts"))
+
+    @property
+    def post(self) -> Path:
+        return self.root / "post"
+
+    @property
+    def crossings_csv(self) -> Path:
+        return self.post / "crossings.csv"
+
+    @property
+    def crossings_plot(self) -> Path:
+        return self.post / "crossings.png"
+
+    @property
+    def mean_temperature_csv(self) -> Path:
+        return self.post / "mean_temperature.csv"
+
+    @property
+    def mean_temperature_plot(self) -> Path:
+        return self.post / "mean_temperature.png"
+
+    @property
+    def particles_plot(self) -> Path:
+        """Cross-section of the particles at the end of the run."""
+        return self.post / "particles_final.png"
+
+    @property
+    def air_heat_csv(self) -> Path:
+        return self.post / "air_heat.csv"
+
+    @property
+    def air_heat_plot(self) -> Path:
+        return self.post / "air_heat.png"
+
+    @property
+    def methodology_json(self) -> Path:
+        return self.post / "methodology.json"
+
+    @property
+    def steps_csv(self) -> Path:
+        """The methodology's per-step table."""
+        return self.post / "steps.csv"
 
     # -- case binding ------------------------------------------------------------------
-    def bind_case(self, case_json: str, case_hash: str, case_toml: str, force: bool = False) -> None:
+    def bind_case(self, case_json: str, case_hash: str, case_toml: str, force: bool = False,
+                  versions: dict[str, Any] | None = None) -> None:
         """Tie the directory to a case; refuse a different case unless ``force``.
+
+        ``versions`` are the software versions to record (the launch profile's
+        :meth:`~drumflow.runner.LaunchProfile.software_versions`; looked up when not given).
 
         Raises
         ------
@@ -133,15 +229,15 @@ class RunDir:
             )
         if old != case_hash:
             # A changed case invalidates every finished stage.
-            for marker in (self.root / "stages").glob("*.json"):
+            for marker in self.stages.glob("*.json"):
                 marker.unlink()
-        (self.root / "case.toml").write_text(case_toml)
+        self.case_toml.write_text(case_toml)
         self.manifest.update(
             {
                 "case": json.loads(case_json),
                 "case_hash": case_hash,
                 "case_file_sha256": hashlib.sha256(case_toml.encode()).hexdigest(),
-                "versions": software_versions(),
+                "versions": versions if versions is not None else software_versions(),
             }
         )
         self.manifest.setdefault("created", time.strftime("%Y-%m-%dT%H:%M:%S%z"))
@@ -149,7 +245,7 @@ class RunDir:
 
     # -- stages ------------------------------------------------------------------------
     def _marker(self, stage: str) -> Path:
-        return self.root / "stages" / f"{stage}.json"
+        return self.stages / f"{stage}.json"
 
     def stage_done(self, stage: str, key: str) -> dict[str, Any] | None:
         """The stage's recorded result if it finished with the same input ``key``."""
@@ -188,8 +284,9 @@ class RunDir:
         tmp.write_text(json.dumps(self.manifest, indent=2, default=str))
         tmp.replace(self.manifest_path)  # atomic: an interrupt never leaves half a manifest
 
-    def require(self, *relative: str) -> None:
-        """Raise :class:`RunDirectoryError` naming what is missing."""
-        for rel in relative:
-            if not (self.root / rel).exists():
+    def require(self, *paths: Path) -> None:
+        """Raise :class:`RunDirectoryError` naming what is missing (paths of this directory)."""
+        for path in paths:
+            if not path.exists():
+                rel = path.relative_to(self.root) if path.is_relative_to(self.root) else path
                 raise RunDirectoryError(f"{self.root}: missing {rel}; run `drumflow run` first")

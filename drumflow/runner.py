@@ -14,19 +14,32 @@ split ASE makes between a calculator's template and its profile.
 from __future__ import annotations
 
 import os
+import platform
 import re
 import shutil
 import signal
 import subprocess
+import sys
 import threading
 import time
 from collections import deque
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import asdict, dataclass, field
+from importlib import metadata
 from pathlib import Path
-from typing import Any
+from typing import IO, TYPE_CHECKING, Any
 
 from drumflow.errors import SolverError, SolverNotFoundError, SolverTimeoutError
+
+if TYPE_CHECKING:
+    from drumflow.case import Case
+
+#: Where the Debian package installs OpenFOAM's ``etc/`` tree; ``WM_PROJECT_DIR`` overrides.
+DEFAULT_OPENFOAM_DIR = "/usr/share/openfoam"
+
+#: Python packages whose versions go into every manifest.
+_PACKAGES = ("drumflow", "numpy", "scipy", "pandas", "gmsh", "meshio", "pyvista", "pydantic",
+             "jinja2", "foamlib", "matplotlib", "typer", "rich")
 
 #: Patterns of lines that carry a program's own error message.
 ERROR_PATTERNS = (
@@ -74,17 +87,36 @@ def last_error_line(lines: Sequence[str]) -> str | None:
 
 @dataclass
 class LaunchProfile:
-    """How to launch programs on this machine.
+    """How to launch programs on this machine: binaries, MPI launcher, environment, cores.
+
+    The case says what to compute; the profile says with what on this machine. Everything that
+    depends on the machine (the core count, where OpenFOAM lives, which solver versions are
+    installed) is read here, never inside the hashed case.
 
     Parameters
     ----------
     mpirun
         The MPI launcher; ``DRUMFLOW_MPIRUN`` overrides it.
+    liggghts
+        The LIGGGHTS executable.
+    python
+        The Python interpreter for drumflow's own child processes (coupling loop, renders).
+    openfoam_dir
+        OpenFOAM's ``WM_PROJECT_DIR`` (the Debian OpenFOAM v1912 binaries in /usr/bin find
+        their ``etc/`` files through it); the environment variable overrides the default.
+    cores
+        Cores available for MPI ranks ('auto' process counts are capped by it).
     env
         Extra environment for every program.
     """
 
     mpirun: str = field(default_factory=lambda: os.environ.get("DRUMFLOW_MPIRUN", "mpirun"))
+    liggghts: str = "liggghts"
+    python: str = sys.executable
+    openfoam_dir: str = field(
+        default_factory=lambda: os.environ.get("WM_PROJECT_DIR", DEFAULT_OPENFOAM_DIR)
+    )
+    cores: int = field(default_factory=lambda: os.cpu_count() or 1)
     env: dict[str, str] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
@@ -102,6 +134,71 @@ class LaunchProfile:
         MPI_Abort before its error message is flushed, leaving an empty log.
         """
         return [self.mpirun, "-np", str(processes), *program]
+
+    def liggghts_command(self, deck: str, log: str, processes: int) -> list[str]:
+        """LIGGGHTS on ``deck`` writing its own ``log``, under the MPI launcher."""
+        return self.mpi_command([self.liggghts, "-in", deck, "-log", log], processes)
+
+    def python_module_command(self, module: str, *args: str, processes: int | None = None) -> list[str]:
+        """``python -m module args``, under the MPI launcher when ``processes`` is given."""
+        command = [self.python, "-m", module, *args]
+        return command if processes is None else self.mpi_command(command, processes)
+
+    def openfoam_env(self) -> dict[str, str]:
+        """Environment every OpenFOAM program needs (``WM_PROJECT_DIR``)."""
+        return {"WM_PROJECT_DIR": self.openfoam_dir}
+
+    def processes_for(self, case: Case) -> int:
+        """MPI processes for a case on this machine (``run.processes``, or 'auto' capped by
+        :attr:`cores`)."""
+        return case.processes(self.cores)
+
+    def software_versions(self) -> dict[str, Any]:
+        """Versions of drumflow, the solvers, Python and the Python packages it uses."""
+        packages: dict[str, str | None] = {}
+        for name in _PACKAGES:
+            try:
+                packages[name] = metadata.version(name)
+            except metadata.PackageNotFoundError:
+                packages[name] = None
+        return {
+            "python": sys.version.split()[0],
+            "platform": platform.platform(),
+            "liggghts": _dpkg_version("liggghts"),
+            "openfoam": _dpkg_version("openfoam"),
+            "openmpi": _dpkg_version("openmpi-bin"),
+            "packages": packages,
+        }
+
+
+def _dpkg_version(package: str) -> str | None:
+    """The installed Debian package version, or ``None`` (no dpkg, not installed)."""
+    out = capture_output(["dpkg-query", "-W", "-f=${Version}", package], timeout=10)
+    return out.strip() or None if out is not None else None
+
+
+def capture_output(command: Sequence[str], timeout: float = 10.0) -> str | None:
+    """Standard output of a short query program (a version lookup), or ``None`` if it is
+    missing, fails or runs out of time.
+
+    Like :meth:`Runner.run` it starts the program in its own process group, which a timeout
+    kills whole; unlike it there is no log file, because nothing here is worth keeping.
+    """
+    if shutil.which(command[0]) is None:
+        return None
+    try:
+        proc = subprocess.Popen(
+            list(command), stdout=subprocess.PIPE, stderr=subprocess.DEVNULL,
+            stdin=subprocess.DEVNULL, text=True, start_new_session=True,
+        )
+    except OSError:
+        return None
+    try:
+        out, _ = proc.communicate(timeout=timeout)
+    except subprocess.TimeoutExpired:
+        _kill_group(proc)
+        return None
+    return out if proc.returncode == 0 else None
 
 
 class Runner:
@@ -166,20 +263,11 @@ class Runner:
             Non-zero return code, or ``check`` found an error.
         """
         command = [str(c) for c in command]
-        exe = command[0]
-        if shutil.which(exe) is None and not Path(exe).exists():
-            raise SolverNotFoundError(
-                program, command, None, None, reason=f"{exe} not found; run scripts/install.sh"
-            )
+        _require_executable(program, command)
         cwd.mkdir(parents=True, exist_ok=True)
         log.parent.mkdir(parents=True, exist_ok=True)
-        full_env = dict(os.environ)
-        full_env.update(self.profile.env)
-        if env:
-            full_env.update(env)
-        tail: deque[str] = deque(maxlen=400)
-        started = time.time()
-        record = RunRecord(program, command, str(cwd), str(log), None, 0.0, started)
+        full_env = {**os.environ, **self.profile.env, **(env or {})}
+        record = RunRecord(program, command, str(cwd), str(log), None, 0.0, time.time())
         self.records.append(record)
         with log.open("w", encoding="utf-8", errors="replace") as fh:
             fh.write(f"# drumflow runner: {' '.join(command)}\n# cwd: {cwd}\n")
@@ -196,85 +284,33 @@ class Runner:
                 bufsize=1,
                 start_new_session=True,  # own process group: killpg reaches mpirun's ranks
             )
-
-            stops: list[StopRun] = []
-
-            def notify(line: str) -> None:
-                if on_line is not None and not stops:
-                    try:
-                        on_line(line)
-                    except StopRun as stop:
-                        stops.append(stop)
-                    except Exception:  # a progress display must never kill a solver run
-                        pass
-
-            def pump() -> None:
-                assert proc.stdout is not None
-                for line in proc.stdout:
-                    fh.write(line)
-                    tail.append(line.rstrip("\n"))
-                    if follow is None:
-                        notify(line)
-                fh.flush()
-
-            reader = threading.Thread(target=pump, daemon=True)
-            reader.start()
-            stop_follow = threading.Event()
-            follower = None
-            if follow is not None:
-                follower = threading.Thread(
-                    target=_follow_file, args=(follow, notify, stop_follow), daemon=True
-                )
-                follower.start()
-            def halt(status: str) -> None:
-                stop_follow.set()
-                _kill_group(proc)
-                reader.join(5)
-                record.status = status
-                record.wall_time_s = time.time() - started
-
+            watch = _Watch(proc, fh, on_line, follow)
             try:
-                deadline = None if timeout is None else started + timeout
-                while True:
-                    try:
-                        proc.wait(timeout=0.2)
-                        break
-                    except subprocess.TimeoutExpired:
-                        if stops:
-                            break
-                        if deadline is not None and time.time() > deadline:
-                            raise
+                _wait(proc, watch, record.started, timeout)
             except subprocess.TimeoutExpired:
-                halt("timeout")
+                watch.halt(record, "timeout")
                 raise SolverTimeoutError(
                     program,
                     command,
                     None,
                     log,
-                    last_error_line(list(tail)),
+                    last_error_line(list(watch.tail)),
                     reason=f"{program} ran longer than {timeout:g} s and was stopped",
                 ) from None
             except BaseException:
                 # Ctrl-C (KeyboardInterrupt) or anything else: never leave solvers behind.
-                halt("interrupted")
+                watch.halt(record, "interrupted")
                 raise
-            if stops:
-                # A monitor (on_line) found the run going wrong: stop it; its error is raised
-                # below, once the output threads have finished.
-                _kill_group(proc)
-            reader.join()
-            stop_follow.set()
-            if follower is not None:
-                follower.join(5)
-            if stops:
+            watch.finish()
+            if watch.stops:
                 # The monitor's verdict (also on the last lines) outranks how the program ended.
                 record.returncode = proc.returncode
                 record.status = "stopped"
-                record.wall_time_s = time.time() - started
-                raise stops[0].error
+                record.wall_time_s = time.time() - record.started
+                raise watch.stops[0].error
         record.returncode = proc.returncode
-        record.wall_time_s = time.time() - started
-        lines = list(tail)
+        record.wall_time_s = time.time() - record.started
+        lines = list(watch.tail)
         problem = check(proc.returncode, lines) if check else None
         if proc.returncode != 0 or problem:
             record.status = "failed"
@@ -287,6 +323,93 @@ class Runner:
                 reason=problem,
             )
         return record
+
+
+def _require_executable(program: str, command: list[str]) -> None:
+    exe = command[0]
+    if shutil.which(exe) is None and not Path(exe).exists():
+        raise SolverNotFoundError(
+            program, command, None, None, reason=f"{exe} not found; run scripts/install.sh"
+        )
+
+
+def _wait(proc: subprocess.Popen[str], watch: _Watch, started: float, timeout: float | None) -> None:
+    """Wait for the program to end or a monitor to stop it; raise ``TimeoutExpired`` at the
+    deadline."""
+    deadline = None if timeout is None else started + timeout
+    while True:
+        try:
+            proc.wait(timeout=0.2)
+            return
+        except subprocess.TimeoutExpired:
+            if watch.stops:
+                return
+            if deadline is not None and time.time() > deadline:
+                raise
+
+
+class _Watch:
+    """The threads that copy a program's output to its log and pass lines to ``on_line``.
+
+    Standard output always goes to the log (and the last 400 lines to :attr:`tail`); the lines
+    for ``on_line`` come from standard output, or from ``follow`` when the program writes its
+    own log. A :class:`StopRun` raised by ``on_line`` is kept in :attr:`stops`.
+    """
+
+    def __init__(self, proc: subprocess.Popen[str], fh: IO[str],
+                 on_line: Callable[[str], None] | None, follow: Path | None) -> None:
+        self.proc = proc
+        self.fh = fh
+        self.on_line = on_line
+        self.follow = follow
+        self.tail: deque[str] = deque(maxlen=400)
+        self.stops: list[StopRun] = []
+        self.stop_follow = threading.Event()
+        self.reader = threading.Thread(target=self._pump, daemon=True)
+        self.reader.start()
+        self.follower: threading.Thread | None = None
+        if follow is not None:
+            self.follower = threading.Thread(
+                target=_follow_file, args=(follow, self._notify, self.stop_follow), daemon=True
+            )
+            self.follower.start()
+
+    def _notify(self, line: str) -> None:
+        if self.on_line is not None and not self.stops:
+            try:
+                self.on_line(line)
+            except StopRun as stop:
+                self.stops.append(stop)
+            except Exception:  # a progress display must never kill a solver run
+                pass
+
+    def _pump(self) -> None:
+        assert self.proc.stdout is not None
+        for line in self.proc.stdout:
+            self.fh.write(line)
+            self.tail.append(line.rstrip("\n"))
+            if self.follow is None:
+                self._notify(line)
+        self.fh.flush()
+
+    def halt(self, record: RunRecord, status: str) -> None:
+        """Kill the process group (timeout, interrupt) and record how the run ended."""
+        self.stop_follow.set()
+        _kill_group(self.proc)
+        self.reader.join(5)
+        record.status = status
+        record.wall_time_s = time.time() - record.started
+
+    def finish(self) -> None:
+        """After the program ended (or a monitor stopped it): drain the output threads."""
+        if self.stops:
+            # A monitor (on_line) found the run going wrong: stop it; its error is raised by
+            # the caller, once the output threads have finished.
+            _kill_group(self.proc)
+        self.reader.join()
+        self.stop_follow.set()
+        if self.follower is not None:
+            self.follower.join(5)
 
 
 def _follow_file(path: Path, notify: Callable[[str], None], stop: threading.Event) -> None:

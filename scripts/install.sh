@@ -11,7 +11,8 @@ if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
 # Solvers and the libraries the gmsh and VTK wheels load (GLU, X fonts, off-screen GL).
 apt_packages=(liggghts openmpi-bin openfoam python3-venv python3-pip
               libglu1-mesa libxcursor1 libxft2 libxinerama1 libxrender1 libgl1 libegl1 libosmesa6
-              chromium)
+              chromium
+              slurmctld slurmd munge slurm-client)  # SLURM: `drumflow sweep` on a cluster, its tests
 missing=()
 for p in "${apt_packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -1,8 +1,8 @@
-"""Copy a smoke-scene bench's measured numbers into the package (drumflow/bench/measured_smoke.json).
+"""Copy a smoke-scene bench's measured numbers into the package (drumflow/data/measured_smoke.json).
 
 Usage: python scripts/ship_bench.py [runs/bench/smoke/results.json]
 
-Runs record their shortcuts with these numbers in the manifest (drumflow.bench.skips).
+Runs record their shortcuts with these numbers in the manifest (drumflow.skips).
 """
 
 from __future__ import annotations
@@ -33,7 +33,7 @@ def main() -> None:
         "liggghts": summary.get("software", {}).get("liggghts"),
         "command": f"drumflow bench cases/{summary['scene']}.toml",
     }
-    out = Path(__file__).resolve().parents[1] / "drumflow" / "bench" / "measured_smoke.json"
+    out = Path(__file__).resolve().parents[1] / "drumflow" / "data" / "measured_smoke.json"
     out.write_text(json.dumps({"source": meta, "rows": rows}, indent=1, default=str) + "\n")
     print(f"written {out} ({len(rows)} rungs)")
 

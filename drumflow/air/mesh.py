@@ -1,7 +1,8 @@
 """OpenFOAM mesh of the drum's air: gmsh mesh -> ``gmshToFoam`` -> patch types -> ``checkMesh``.
 
 Every OpenFOAM program runs through :class:`drumflow.runner.Runner` (logged, timed out, typed
-errors) with ``WM_PROJECT_DIR`` set, because the Debian OpenFOAM v1912 binaries in /usr/bin
+errors) with ``WM_PROJECT_DIR`` set by the launch profile
+(:meth:`drumflow.runner.LaunchProfile.openfoam_env`), because the Debian OpenFOAM v1912 binaries in /usr/bin
 find their ``etc/`` files (``controlDict`` defaults, function-object templates) through it.
 
 ``gmshToFoam`` makes every physical surface group a plain ``patch``; wall functions and the MRF
@@ -11,30 +12,16 @@ rewrites ``constant/polyMesh/boundary`` with foamlib afterwards.
 
 from __future__ import annotations
 
-import os
 import re
 from collections.abc import Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, cast
 
-from drumflow.errors import SolverError
+from drumflow.errors import MeshCheckError, SolverError
 from drumflow.runner import Runner
 
 if TYPE_CHECKING:
     from drumflow.case import Case
-
-#: Where the Debian package installs OpenFOAM's ``etc/`` tree; ``WM_PROJECT_DIR`` overrides.
-DEFAULT_OPENFOAM_DIR = "/usr/share/openfoam"
-
-
-class MeshCheckError(SolverError):
-    """``checkMesh`` reported failed checks: the mesh would give a wrong or diverging air field."""
-
-
-def openfoam_env() -> dict[str, str]:
-    """Environment every OpenFOAM program needs (``WM_PROJECT_DIR``)."""
-    return {"WM_PROJECT_DIR": os.environ.get("WM_PROJECT_DIR", DEFAULT_OPENFOAM_DIR)}
-
 
 def foam_check(returncode: int, lines: list[str]) -> str | None:
     """A :class:`Runner` ``check``: OpenFOAM can print ``FOAM FATAL`` and still exit 0."""
@@ -62,7 +49,7 @@ def run_foam(
         log=log,
         timeout=timeout,
         on_line=on_line,
-        env=openfoam_env(),
+        env=runner.profile.openfoam_env(),
         check=foam_check,
     )
     return log

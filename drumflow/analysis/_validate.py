@@ -14,7 +14,7 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from drumflow.errors import DrumflowError
+from drumflow.errors import AnalysisInputError
 
 __all__ = [
     "AnalysisInputError",
@@ -25,41 +25,6 @@ __all__ = [
     "check_same_length",
     "exactly_one",
 ]
-
-
-class AnalysisInputError(DrumflowError, ValueError):
-    """An argument of an analysis function is outside its allowed range.
-
-    It subclasses :class:`ValueError` so callers that do not know drumflow can still catch it,
-    and :class:`drumflow.errors.DrumflowError` so the CLI reports it as a drumflow error.
-
-    Parameters
-    ----------
-    name
-        Name of the argument (as in the function signature, with an index for array items).
-    value
-        The rejected value (already formatted or any object; it is shown with ``repr``).
-    allowed
-        Human-readable description of the accepted values, e.g. ``"a finite number > 0"``.
-    """
-
-    def __init__(self, name: str, value: object, allowed: str) -> None:
-        self.name = name
-        self.value = value
-        self.allowed = allowed
-        super().__init__(f"{name} = {_show(value)} is not allowed: expected {allowed}")
-
-
-def _show(value: object) -> str:
-    # numpy scalars print as np.float64(1.0) with repr; convert to plain Python first so
-    # messages read the same whatever the caller passed.
-    if isinstance(value, np.generic):
-        value = value.item()
-    if isinstance(value, float):
-        return f"{value:.6g}"
-    if isinstance(value, str):
-        return value
-    return repr(value)
 
 
 def check_finite(name: str, value: object) -> float:

@@ -37,6 +37,19 @@ of ``ln Re``; ``c`` cannot then be separated from ``a`` and ``b``. The fit check
 held at ``fixed_prandtl_exponent`` (default 1/3) and only ``a`` and ``b`` are fitted, and the result
 says so. The paper's data (two runs at Pr ~ 0.728) are in that situation: its c = 1.008 is not
 determined by the data; only ``a Pr^c`` is.
+
+Serially correlated steps. The ANOVA and the standard errors above treat every time step as an
+independent observation. Consecutive steps of one run are not: the residuals of the paper-style
+fit follow the slow drift of the mean temperature, so the lag-1 autocorrelation of the residuals
+is close to 1 and the 4,799 error degrees of freedom of Table 8 overstate the information in the
+data. :class:`SerialCorrelation` gives the honest version beside it: the pooled lag-1
+autocorrelation ``rho`` of the residuals within each run, the effective sample size of an AR(1)
+series ``n_eff = n (1 - rho) / (1 + rho)`` (Bayley and Hammersley 1946; the variance of a mean of
+AR(1) data is ``(1 + rho) / (1 - rho)`` times the independent one), the standard errors inflated
+by ``sqrt(n / n_eff)`` and confidence intervals from the t distribution with ``n_eff - p``
+degrees of freedom. The inflation is exact for a regressor that varies slowly within a run (as
+Re does here: only through ``nu(T_ma)``); for a regressor that jumps at random from step to step
+it overstates the error. A negative ``rho`` is taken as 0 (never narrower than the naive errors).
 """
 
 from __future__ import annotations
@@ -66,7 +79,10 @@ __all__ = [
     "AnovaTable",
     "CorrelationRangeWarning",
     "NusseltCorrelation",
+    "SerialCorrelation",
     "anova_table",
+    "effective_sample_size",
+    "lag1_autocorrelation",
     "fit_nusselt_correlation",
     "fit_nusselt_correlation_from_runs",
 ]
@@ -185,6 +201,80 @@ def anova_table(ss_total: float, ss_error: float, n: int, n_params: int) -> Anov
     )
 
 
+def lag1_autocorrelation(residuals: ArrayLike, segments: ArrayLike | None = None) -> float:
+    """Pooled lag-1 autocorrelation of residuals, pairs taken within a segment only.
+
+    Parameters
+    ----------
+    residuals
+        Residuals in time order (1-D).
+    segments
+        A label per residual (e.g. the run it comes from); a pair of neighbours counts only when
+        both have the same label, so the seam between two runs is not a lag. None: one series.
+
+    Returns
+    -------
+    float
+        ``(sum r_i r_(i+1) / pairs) / (sum r_i^2 / n)``; NaN with no pair or zero residuals.
+        The residuals are not centred: a run whose residuals share a sign (a misfit of that
+        run) is serial correlation too, and centring would hide it.
+    """
+    r = as_float_array("residuals", residuals)
+    labels = np.zeros(r.size, dtype=np.int64) if segments is None else np.asarray(segments)
+    if labels.shape != r.shape:
+        raise AnalysisInputError("segments", f"{labels.size} label(s)", f"one per residual ({r.size})")
+    same = labels[1:] == labels[:-1]
+    pairs = int(same.sum())
+    power = float(r @ r) / r.size if r.size else 0.0
+    if pairs == 0 or power == 0.0:
+        return math.nan
+    return float(np.sum(r[1:][same] * r[:-1][same]) / pairs / power)
+
+
+def effective_sample_size(n: int, rho: float) -> float:
+    """Effective number of independent observations of an AR(1) series of ``n`` points.
+
+    ``n (1 - rho) / (1 + rho)`` with ``rho`` clipped to ``[0, 1)``: a negative autocorrelation
+    is not allowed to claim more information than ``n`` independent points.
+    """
+    if not math.isfinite(rho):
+        return float(n)
+    r = min(max(rho, 0.0), 1.0 - 1e-12)
+    return n * (1.0 - r) / (1.0 + r)
+
+
+@dataclass(frozen=True)
+class SerialCorrelation:
+    """Standard errors of the fit allowing for serially correlated time steps.
+
+    Attributes
+    ----------
+    lag1
+        Pooled lag-1 autocorrelation of the residuals within each run (:func:`lag1_autocorrelation`).
+    n_effective
+        ``n (1 - rho) / (1 + rho)`` (:func:`effective_sample_size`).
+    df_effective
+        ``max(n_effective - p, 1)``: degrees of freedom of the t quantile.
+    inflation
+        ``sqrt(n / n_effective)``: the factor on the naive standard errors.
+    se_a, se_b, se_c
+        The naive standard errors times ``inflation`` (``se_c`` stays 0 when c was fixed).
+    ci_a, ci_b, ci_c
+        Confidence intervals ``estimate +/- t(df_effective) se``.
+    """
+
+    lag1: float
+    n_effective: float
+    df_effective: float
+    inflation: float
+    se_a: float
+    se_b: float
+    se_c: float
+    ci_a: tuple[float, float]
+    ci_b: tuple[float, float]
+    ci_c: tuple[float, float]
+
+
 @dataclass(frozen=True)
 class NusseltCorrelation:
     """Fitted correlation ``Nu = a Re^b Pr^c`` with its statistics.
@@ -214,6 +304,9 @@ class NusseltCorrelation:
         ``sqrt(SSE / (n - p))``.
     reynolds_range, prandtl_range
         ``(min, max)`` of the data, the validity range of the correlation.
+    serial
+        The standard errors allowing for serially correlated steps (module notes); None when
+        there is no pair of consecutive points.
     """
 
     a: float
@@ -236,6 +329,7 @@ class NusseltCorrelation:
     residual_std: float
     reynolds_range: tuple[float, float]
     prandtl_range: tuple[float, float]
+    serial: SerialCorrelation | None = None
 
     def in_range(self, reynolds: ArrayLike, prandtl: ArrayLike) -> NDArray[np.bool_]:
         """True where ``(Re, Pr)`` lies inside the ranges of the fitted data."""
@@ -295,7 +389,7 @@ def _collect(
     reynolds: ArrayLike,
     prandtl: ArrayLike,
     drop_nonpositive: bool,
-) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], int]:
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.bool_]]:
     nu = as_float_array("nusselt", nusselt, allow_nan=True)
     re = as_float_array("reynolds", reynolds, allow_nan=True)
     pr = as_float_array("prandtl", prandtl, allow_nan=True)
@@ -303,7 +397,6 @@ def _collect(
     keep = np.isfinite(nu) & np.isfinite(re) & np.isfinite(pr)
     if drop_nonpositive:
         keep &= (nu > 0.0) & (re > 0.0) & (pr > 0.0)
-    n_dropped = int((~keep).sum())
     nu, re, pr = nu[keep], re[keep], pr[keep]
     for name, arr in (("nusselt", nu), ("reynolds", re), ("prandtl", pr)):
         nonpos = arr <= 0.0
@@ -314,7 +407,7 @@ def _collect(
                 "values > 0 (a power law needs positive data; filter the steps, e.g. h > 0, "
                 "or pass drop_nonpositive=True)",
             )
-    return nu, re, pr, n_dropped
+    return nu, re, pr, keep
 
 
 def _residual_spread(y: NDArray[np.float64], x: NDArray[np.float64] | None) -> float:
@@ -336,6 +429,7 @@ def fit_nusselt_correlation(
     spread_tol: float = 1e-3,
     drop_nonpositive: bool = False,
     confidence: float = 0.95,
+    segments: ArrayLike | None = None,
 ) -> NusseltCorrelation:
     """Fit ``Nu = a Re^b Pr^c`` by Levenberg-Marquardt, Eq. 56.
 
@@ -359,6 +453,10 @@ def fit_nusselt_correlation(
         Drop points with a non-positive value instead of raising.
     confidence
         Level of the confidence intervals (default 0.95).
+    segments
+        A label per point naming the run (time series) it belongs to, in time order within a
+        run; used only for the serial-correlation errors (``serial``). None: the points are one
+        time series.
 
     Returns
     -------
@@ -376,7 +474,15 @@ def fit_nusselt_correlation(
         raise AnalysisInputError("fixed_prandtl_exponent", c_fixed, "a finite number")
     if not 0.0 < confidence < 1.0:
         raise AnalysisInputError("confidence", confidence, "a value in (0, 1)")
-    nu, re, pr, n_dropped = _collect(nusselt, reynolds, prandtl, drop_nonpositive)
+    nu, re, pr, keep = _collect(nusselt, reynolds, prandtl, drop_nonpositive)
+    n_dropped = int((~keep).sum())
+    labels: NDArray[np.int64] | None = None
+    if segments is not None:
+        all_labels = np.asarray(segments)
+        if all_labels.shape != keep.shape:
+            raise AnalysisInputError("segments", f"{all_labels.size} label(s)",
+                                     f"one per point ({keep.size})")
+        labels = all_labels[keep]
 
     ln_nu, ln_re, ln_pr = np.log(nu), np.log(re), np.log(pr)
     n = int(nu.size)
@@ -469,6 +575,8 @@ def fit_nusselt_correlation(
     se_a, se_b = float(se[0]), float(se[1])
     se_c = float(se[2]) if fit_c else 0.0
 
+    serial = _serial(res, labels, n, n_params, (a, b, c), (se_a, se_b, se_c), confidence)
+
     sst_c = float(np.sum((nu - nu.mean()) ** 2))
     if sst_c > 0.0:
         r2 = 1.0 - sse / sst_c
@@ -497,7 +605,26 @@ def fit_nusselt_correlation(
         residual_std=math.sqrt(s2),
         reynolds_range=(float(re.min()), float(re.max())),
         prandtl_range=(float(pr.min()), float(pr.max())),
+        serial=serial,
     )
+
+
+def _serial(residuals: NDArray[np.float64], labels: NDArray[np.int64] | None, n: int,
+            n_params: int, estimates: tuple[float, float, float],
+            naive_se: tuple[float, float, float], confidence: float) -> SerialCorrelation | None:
+    """The naive errors widened for the lag-1 autocorrelation of the residuals (module notes)."""
+    rho = lag1_autocorrelation(residuals, labels)
+    if not math.isfinite(rho):
+        return None
+    n_eff = effective_sample_size(n, rho)
+    inflation = math.sqrt(n / n_eff)
+    df = max(n_eff - n_params, 1.0)
+    t_crit = float(stats.t.ppf(0.5 + confidence / 2.0, df))
+    se = tuple(inflation * e for e in naive_se)
+    ci = tuple((v - t_crit * e, v + t_crit * e) for v, e in zip(estimates, se, strict=True))
+    return SerialCorrelation(lag1=rho, n_effective=n_eff, df_effective=df, inflation=inflation,
+                             se_a=se[0], se_b=se[1], se_c=se[2], ci_a=ci[0], ci_b=ci[1],
+                             ci_c=ci[2])
 
 
 def fit_nusselt_correlation_from_runs(
@@ -553,6 +680,8 @@ def fit_nusselt_correlation_from_runs(
         prs.append(arrays[2])
     if not nus:
         raise AnalysisInputError("runs", "an empty sequence", "at least one run")
+    # Each run is its own time series: the serial correlation is measured within runs.
+    kwargs.setdefault("segments", np.concatenate([np.full(v.size, i) for i, v in enumerate(nus)]))
     return fit_nusselt_correlation(
         np.concatenate(nus),
         np.concatenate(res),

@@ -13,7 +13,7 @@ Eq. 55   ``V_m = 4/3 pi (Dp/2)^3 N``
 =======  ==========================================================================
 
 Air properties (``k``, ``nu``, ``Pr``) are interpolated at ``T_ma`` from
-:mod:`drumflow.analysis.air_properties`. The mean air inlet velocity is, unless given,
+:mod:`drumflow.air_properties`. The mean air inlet velocity is, unless given,
 ``V_ai = mdot_a / (rho_air(T_ai) pi D^2 / 4)``, i.e. the air flow spread over the full drum
 cross-section (the paper does not give the inlet area it used).
 
@@ -24,6 +24,14 @@ reproduced only with the particle conductivity ``k_m = 0.18596`` W/(m K) of its 
 correlation (Eq. 58) gives at the ends of its Re range (3073 and 7686) at ``Pr = 0.7282``, whereas
 the air conductivity gives Nu of about 18 and 29. Pass ``conductivity_w_mk=0.18596`` to reproduce
 the paper.
+
+Which Reynolds number? drumflow's is Eqs. 51-54 as printed, with the inlet velocity spread over
+the whole drum cross-section (above). For the paper's two models that gives 1844 and 4609; the
+paper reports 3073 and 7686, 1.667 times more for both models (its Re implies v_max = 6.23 m/s
+against V_ai / Vf = 3.74 m/s here). Every Re drumflow computes, fits or compares is this one;
+the paper's Re and its Eq. 58 are converted to it once
+(:func:`drumflow.analysis.paper.reynolds_conversion`,
+:func:`drumflow.analysis.predict.paper_correlation`).
 """
 
 from __future__ import annotations
@@ -35,7 +43,7 @@ from typing import TypeVar
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from drumflow.analysis import air_properties as air
+from drumflow import air_properties as air
 from drumflow.analysis._validate import (
     AnalysisInputError,
     as_float_array,

@@ -40,6 +40,7 @@ from drumflow.analysis._validate import (
     exactly_one,
 )
 from drumflow.analysis.heat_transfer import log_mean_temperature_difference
+from drumflow.errors import InfeasibleExchangerError
 
 __all__ = [
     "ExchangerResult",
@@ -49,10 +50,6 @@ __all__ = [
     "exchanger_area_from_section",
     "solve_outlet_temperature",
 ]
-
-
-class InfeasibleExchangerError(AnalysisInputError):
-    """The requested operating point violates the second law (e.g. a temperature cross)."""
 
 
 @dataclass(frozen=True)

@@ -47,8 +47,10 @@ import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
-from drumflow.analysis._validate import AnalysisInputError
-from drumflow.analysis.correlation import NusseltCorrelation, fit_nusselt_correlation_from_runs
+from drumflow.analysis.correlation import (
+    NusseltCorrelation,
+    fit_nusselt_correlation_from_runs,
+)
 from drumflow.analysis.dimensionless import dimensionless_numbers
 from drumflow.analysis.exchanger import (
     ExchangerResult,
@@ -57,15 +59,20 @@ from drumflow.analysis.exchanger import (
     exchanger_area_from_section,
     solve_outlet_temperature,
 )
-from drumflow.analysis.heat_transfer import falling_particle_area, per_step_heat_transfer
+from drumflow.analysis.heat_transfer import (
+    falling_particle_area,
+    per_step_heat_transfer,
+)
 from drumflow.case import Case, load_case
-from drumflow.errors import RunDirectoryError
+from drumflow.errors import (
+    AnalysisInputError,
+    MissingRunFileError,
+    NoHeatTransferError,
+    RunDirectoryError,
+)
+from drumflow.rundir import RunDir
 
 __all__ = [
-    "CASE_FILE",
-    "MEAN_TEMPERATURE_FILE",
-    "METHODOLOGY_FILE",
-    "STEPS_FILE",
     "FallingMassMode",
     "MethodologyResult",
     "MissingRunFileError",
@@ -80,15 +87,6 @@ __all__ = [
 FallingMassMode = Literal["mean", "per_step"]
 NusseltConductivity = Literal["air", "particle"]
 
-CASE_FILE = "case.toml"
-"""The validated case, relative to the run directory."""
-MEAN_TEMPERATURE_FILE = "post/mean_temperature.csv"
-"""Mean particle temperature and falling mass per output step, relative to the run directory."""
-METHODOLOGY_FILE = "post/methodology.json"
-"""Written by :func:`write_methodology`."""
-STEPS_FILE = "post/steps.csv"
-"""Per-step table written by :func:`write_methodology`."""
-
 _CSV_COLUMNS = ("time_s", "mean_temperature_C", "particles", "falling_mass_kg_in_step")
 
 # Mask reasons of the per-step table ("" for a valid step).
@@ -100,34 +98,6 @@ _NO_FALL = "no_falling_mass"
 # multiples of the DEM time step (~1e-5 s) written with 10 significant digits, so they can sit a
 # few 1e-10 s off the nominal value. 1e-9 s is far below any DEM time step.
 _TIME_EPS_S = 1e-9
-
-
-class MissingRunFileError(RunDirectoryError):
-    """A file the methodology needs is not in the run directory.
-
-    Parameters
-    ----------
-    path
-        The missing file (absolute).
-    what
-        What the file holds, for the message.
-
-    Attributes
-    ----------
-    path
-        The missing file.
-    """
-
-    def __init__(self, path: Path, what: str) -> None:
-        self.path = path
-        super().__init__(
-            f"{path}: missing ({what}); run `drumflow run CASE --out DIR` (or `drumflow post DIR` "
-            "if the dumps are there) first"
-        )
-
-
-class NoHeatTransferError(RunDirectoryError):
-    """The run cannot give a heat-transfer coefficient (no air, no cooling, no falling mass)."""
 
 
 def plant_streams(
@@ -461,17 +431,72 @@ def analyse_run(
         raise AnalysisInputError("nusselt_conductivity", nusselt_conductivity, "'air' or 'particle'")
     if falling_mass not in ("mean", "per_step"):
         raise AnalysisInputError("falling_mass", falling_mass, "'mean' or 'per_step'")
+    run = _open_run(run_dir)
+    case = load_case(run.case_toml)
+    _require_air(case, run.case_toml)
+    series = _read_series(run.mean_temperature_csv)
+    window = _falling_window_of(series, case, run.mean_temperature_csv)
+    steps = _per_step(case, series, window, falling_mass, run)
+    h_mean = _mean_h(steps, series, run.mean_temperature_csv)
+    k = case.particles.conductivity if nusselt_conductivity == "particle" else None
+    valid = steps.valid
+    try:
+        numbers = dimensionless_numbers(
+            steps.h[valid],
+            steps.air_t[valid],
+            air_inlet_temperature_c=case.air.inlet_temperature_C,
+            particle_diameter_m=case.particles.diameter,
+            drum_diameter_m=case.drum.diameter,
+            section_length_m=case.drum.length,
+            particle_count=case.particle_count,
+            air_mass_flow_kg_s=case.air.mass_flow,
+            conductivity_w_mk=k,
+        )
+    except AnalysisInputError as exc:
+        raise RunDirectoryError(f"{run.mean_temperature_csv} with {run.case_toml}: {exc}") from exc
+    table_out = _steps_table(series, window, steps, numbers)
+    dt_mean = float(np.mean(series.dt))
+    notes = list(window.notes)
+    m_mf, a_fp, a_he, model, plant_result = _exchangers(case, h_mean, window.flow, dt_mean,
+                                                        run.case_toml, notes)
+    return MethodologyResult(
+        run_dir=run.root,
+        case=case,
+        steps=table_out,
+        h_mean_w_m2k=h_mean,
+        falling_mass_mode=falling_mass,
+        falling_mass_flow_kg_s=window.flow,
+        falling_mass_window_s=window.span,
+        dt_s=dt_mean,
+        falling_mass_per_step_kg=m_mf,
+        air_mass_per_step_kg=case.air.mass_flow * dt_mean,
+        falling_area_m2=a_fp,
+        nusselt_conductivity=nusselt_conductivity,
+        void_fraction=numbers.void_fraction,
+        air_inlet_velocity_m_s=numbers.air_inlet_velocity_m_s,
+        max_air_velocity_m_s=numbers.max_air_velocity_m_s,
+        exchanger_area_m2=a_he,
+        exchanger=model,
+        plant_exchanger=plant_result,
+        warnings=tuple(notes),
+    )
+
+
+def _open_run(run_dir: Path | str) -> RunDir:
+    """The run directory, with the two files the methodology reads."""
     root = Path(run_dir).resolve()
     if not root.is_dir():
         raise RunDirectoryError(f"{root}: not a directory (expected a `drumflow run` directory)")
-    case_path = root / CASE_FILE
-    csv_path = root / MEAN_TEMPERATURE_FILE
-    if not case_path.is_file():
-        raise MissingRunFileError(case_path, "the validated case of the run")
-    if not csv_path.is_file():
-        raise MissingRunFileError(csv_path, "mean particle temperature and falling mass per step")
-    case = load_case(case_path)
+    run = RunDir(root, create=False)
+    if not run.case_toml.is_file():
+        raise MissingRunFileError(run.case_toml, "the validated case of the run")
+    if not run.mean_temperature_csv.is_file():
+        raise MissingRunFileError(run.mean_temperature_csv,
+                                  "mean particle temperature and falling mass per step")
+    return run
 
+
+def _require_air(case: Case, case_path: Path) -> None:
     if case.air.model == "none" or case.air.mass_flow <= 0.0:
         why = (
             "air.model = 'none'"
@@ -481,10 +506,23 @@ def analyse_run(
         raise NoHeatTransferError(
             f"{case_path}: the run had no air ({why}), so h cannot be measured: without air the "
             "mean particle temperature changes only by conduction between particles, and "
-            "Eqs. 34-39 need the air to take the heat. It needs a run with air acting on the "
-            "particles (air.model 'uniform' or 'cfd', which this version does not have yet)."
+            "Eqs. 34-39 need the air to take the heat. Run the case with air acting on the "
+            "particles: air.model = 'uniform' (plug flow) or 'cfd' (OpenFOAM), both available, "
+            "and air.mass_flow > 0."
         )
 
+
+@dataclass(frozen=True)
+class _Series:
+    """The run's output steps: times, mean temperature, falling mass per step."""
+
+    t: NDArray[np.float64]
+    temp: NDArray[np.float64]
+    per_step_mass: NDArray[np.float64]  # per step (one fewer than the times)
+    dt: NDArray[np.float64]
+
+
+def _read_series(csv_path: Path) -> _Series:
     table = _read_mean_temperature(csv_path)
     t = table["time_s"].to_numpy(dtype=np.float64)
     temp = table["mean_temperature_C"].to_numpy(dtype=np.float64)
@@ -493,132 +531,166 @@ def analyse_run(
     if np.any(dt <= 0.0):
         row = int(np.flatnonzero(dt <= 0.0)[0]) + 2
         raise RunDirectoryError(f"{csv_path}: time_s is not increasing at data row {row}")
-    n = dt.size
+    return _Series(t, temp, per_step_mass, dt)
 
-    in_window, notes = _falling_window(t, case.run.mass_flow_start)
-    window_mass = float(per_step_mass[in_window].sum())
-    window_time = float(dt[in_window].sum())
-    window = (float(t[:-1][in_window][0]), float(t[1:][in_window][-1]))
+
+@dataclass(frozen=True)
+class _Window:
+    """The falling-mass window (after ``run.mass_flow_start``) and its mean mass flow."""
+
+    in_window: NDArray[np.bool_]
+    span: tuple[float, float]
+    flow: float
+    notes: tuple[str, ...]
+
+
+def _falling_window_of(series: _Series, case: Case, csv_path: Path) -> _Window:
+    in_window, notes = _falling_window(series.t, case.run.mass_flow_start)
+    window_mass = float(series.per_step_mass[in_window].sum())
+    window_time = float(series.dt[in_window].sum())
+    span = (float(series.t[:-1][in_window][0]), float(series.t[1:][in_window][-1]))
     if window_mass <= 0.0:
         raise NoHeatTransferError(
-            f"{csv_path}: no particle fell through the axis plane between {window[0]:g} s and "
-            f"{window[1]:g} s (falling_mass_kg_in_step is 0), so the falling-particle area "
+            f"{csv_path}: no particle fell through the axis plane between {span[0]:g} s and "
+            f"{span[1]:g} s (falling_mass_kg_in_step is 0), so the falling-particle area "
             "(Eq. 41) is zero and h cannot be measured; check the lifters and the rotation speed"
         )
-    flow = window_mass / window_time
-    dt_mean = float(np.mean(dt))
+    return _Window(in_window, span, window_mass / window_time, tuple(notes))
 
-    dp = case.particles.diameter
-    rho = case.particles.density
+
+@dataclass
+class _Steps:
+    """Eqs. 34-41 per step, with steps that cannot give h masked (and why)."""
+
+    particle_dT: NDArray[np.float64]
+    air_mass: NDArray[np.float64]
+    used_mass: NDArray[np.float64]
+    h: NDArray[np.float64]
+    heat: NDArray[np.float64]
+    air_dt: NDArray[np.float64]
+    air_t: NDArray[np.float64]
+    lmtd: NDArray[np.float64]
+    rate: NDArray[np.float64]
+    area: NDArray[np.float64]
+    mask: NDArray[np.object_]
+
+    @property
+    def valid(self) -> NDArray[np.bool_]:
+        return np.isfinite(self.h)
+
+
+def _per_step(case: Case, series: _Series, window: _Window, falling_mass: FallingMassMode,
+              run: RunDir) -> _Steps:
+    n = series.dt.size
     streams = {
         "material_cp_j_kgk": case.particles.heat_capacity,
         "air_mass_flow_kg_s": case.air.mass_flow,
         "air_cp_j_kgk": case.air.heat_capacity,
         "air_inlet_temperature_c": case.air.inlet_temperature_C,
     }
+    dp, rho = case.particles.diameter, case.particles.density
     no_fall = np.zeros(n, dtype=bool)
     try:
         if falling_mass == "mean":
-            used_mass = flow * dt
+            used_mass = window.flow * series.dt
             steps = per_step_heat_transfer(
-                t, temp, particle_diameter_m=dp, particle_density_kg_m3=rho,
-                falling_mass_flow_kg_s=flow, **streams,
+                series.t, series.temp, particle_diameter_m=dp, particle_density_kg_m3=rho,
+                falling_mass_flow_kg_s=window.flow, **streams,
             )
         else:
-            no_fall = per_step_mass <= 0.0
+            no_fall = series.per_step_mass <= 0.0
             # per_step_heat_transfer needs a positive mass everywhere; steps where nothing fell
             # get a placeholder and are masked below (Eq. 41 gives them no area).
-            placeholder = np.where(no_fall, 1.0, per_step_mass)
-            used_mass = np.where(no_fall, 0.0, per_step_mass)
+            placeholder = np.where(no_fall, 1.0, series.per_step_mass)
+            used_mass = np.where(no_fall, 0.0, series.per_step_mass)
             steps = per_step_heat_transfer(
-                t, temp, particle_diameter_m=dp, particle_density_kg_m3=rho,
+                series.t, series.temp, particle_diameter_m=dp, particle_density_kg_m3=rho,
                 falling_mass_kg=placeholder, **streams,
             )
     except AnalysisInputError as exc:
-        raise RunDirectoryError(f"{csv_path} with {case_path}: {exc}") from exc
+        raise RunDirectoryError(f"{run.mean_temperature_csv} with {run.case_toml}: {exc}") from exc
 
-    h = np.array(steps.h_w_m2k, dtype=np.float64)
-    heat = np.array(steps.heat_j, dtype=np.float64)
-    air_dt = np.array(steps.air_dT_c, dtype=np.float64)
-    air_t = np.array(steps.air_temperature_c, dtype=np.float64)
-    lmtd = np.array(steps.lmtd_c, dtype=np.float64)
-    rate = np.array(steps.heat_rate_w, dtype=np.float64)
-    area = np.array(steps.area_m2, dtype=np.float64)
-    mask = np.full(n, "", dtype=object)
-    mask[steps.particle_dT_c == 0.0] = _NO_CHANGE
-    mask[(mask == "") & ~np.isfinite(steps.lmtd_c)] = _CROSS
+    out = _Steps(
+        particle_dT=np.asarray(steps.particle_dT_c),
+        air_mass=np.asarray(steps.air_mass_kg),
+        used_mass=used_mass,
+        h=np.array(steps.h_w_m2k, dtype=np.float64),
+        heat=np.array(steps.heat_j, dtype=np.float64),
+        air_dt=np.array(steps.air_dT_c, dtype=np.float64),
+        air_t=np.array(steps.air_temperature_c, dtype=np.float64),
+        lmtd=np.array(steps.lmtd_c, dtype=np.float64),
+        rate=np.array(steps.heat_rate_w, dtype=np.float64),
+        area=np.array(steps.area_m2, dtype=np.float64),
+        mask=np.full(n, "", dtype=object),
+    )
+    out.mask[steps.particle_dT_c == 0.0] = _NO_CHANGE
+    out.mask[(out.mask == "") & ~np.isfinite(steps.lmtd_c)] = _CROSS
     if no_fall.any():
         # Eq. 35 with m_mf = 0: no heat reaches the air and there is no area; h is undefined.
-        heat[no_fall] = 0.0
-        air_dt[no_fall] = 0.0
-        air_t[no_fall] = case.air.inlet_temperature_C
-        rate[no_fall] = 0.0
-        area[no_fall] = 0.0
-        lmtd[no_fall] = np.nan
-        h[no_fall] = np.nan
-        mask[no_fall] = _NO_FALL
-    valid = np.isfinite(h)
-    n_valid = int(valid.sum())
+        out.heat[no_fall] = 0.0
+        out.air_dt[no_fall] = 0.0
+        out.air_t[no_fall] = case.air.inlet_temperature_C
+        out.rate[no_fall] = 0.0
+        out.area[no_fall] = 0.0
+        out.lmtd[no_fall] = np.nan
+        out.h[no_fall] = np.nan
+        out.mask[no_fall] = _NO_FALL
+    return out
 
+
+def _mean_h(steps: _Steps, series: _Series, csv_path: Path) -> float:
+    """The time average of h over the valid steps (the paper's h)."""
+    valid = steps.valid
+    n, n_valid = valid.size, int(valid.sum())
     if n_valid == 0:
-        counts = {r: int((mask == r).sum()) for r in (_NO_CHANGE, _CROSS, _NO_FALL)}
+        counts = {r: int((steps.mask == r).sum()) for r in (_NO_CHANGE, _CROSS, _NO_FALL)}
         if counts[_NO_CHANGE] == n:
             why = (
-                f"the mean particle temperature never changed ({temp[0]:g} deg C throughout): "
-                "the air took no heat"
+                f"the mean particle temperature never changed ({series.temp[0]:g} deg C "
+                "throughout): the air took no heat"
             )
         else:
             why = ", ".join(f"{v} step(s) {k.replace('_', ' ')}" for k, v in counts.items() if v)
         raise NoHeatTransferError(f"{csv_path}: no valid step of {n}, so h cannot be measured: {why}")
-
-    h_mean = float(np.sum(h[valid] * dt[valid]) / np.sum(dt[valid]))
+    dt = series.dt
+    h_mean = float(np.sum(steps.h[valid] * dt[valid]) / np.sum(dt[valid]))
     if not h_mean > 0.0:
         raise NoHeatTransferError(
             f"{csv_path}: the mean h over {n_valid} valid step(s) is {h_mean:.4g} W/(m2 K), not "
             "positive: the particles did not cool on average, so the cooler model cannot be "
             "applied"
         )
+    return h_mean
 
-    k = case.particles.conductivity if nusselt_conductivity == "particle" else None
-    try:
-        numbers = dimensionless_numbers(
-            h[valid],
-            air_t[valid],
-            air_inlet_temperature_c=case.air.inlet_temperature_C,
-            particle_diameter_m=dp,
-            drum_diameter_m=case.drum.diameter,
-            section_length_m=case.drum.length,
-            particle_count=case.particle_count,
-            air_mass_flow_kg_s=case.air.mass_flow,
-            conductivity_w_mk=k,
-        )
-    except AnalysisInputError as exc:
-        raise RunDirectoryError(f"{csv_path} with {case_path}: {exc}") from exc
+
+def _steps_table(series: _Series, window: _Window, steps: _Steps, numbers: Any) -> pd.DataFrame:
+    """The per-step table (``post/steps.csv``)."""
+    valid = steps.valid
 
     def scatter(values: NDArray[np.float64]) -> NDArray[np.float64]:
-        out = np.full(n, np.nan)
+        out = np.full(valid.size, np.nan)
         out[valid] = values
         return out
 
-    table_out = pd.DataFrame(
+    return pd.DataFrame(
         {
-            "time_s": t[1:],
-            "dt_s": dt,
-            "mean_temperature_C": temp[1:],
-            "particle_dT_K": np.asarray(steps.particle_dT_c),
-            "falling_mass_in_step_kg": per_step_mass,
-            "falling_mass_kg": used_mass,
-            "air_mass_kg": np.asarray(steps.air_mass_kg),
-            "heat_J": heat,
-            "air_dT_K": air_dt,
-            "air_temperature_C": air_t,
-            "lmtd_K": lmtd,
-            "heat_rate_W": rate,
-            "area_fp_m2": area,
-            "h_W_m2K": h,
+            "time_s": series.t[1:],
+            "dt_s": series.dt,
+            "mean_temperature_C": series.temp[1:],
+            "particle_dT_K": steps.particle_dT,
+            "falling_mass_in_step_kg": series.per_step_mass,
+            "falling_mass_kg": steps.used_mass,
+            "air_mass_kg": steps.air_mass,
+            "heat_J": steps.heat,
+            "air_dT_K": steps.air_dt,
+            "air_temperature_C": steps.air_t,
+            "lmtd_K": steps.lmtd,
+            "heat_rate_W": steps.rate,
+            "area_fp_m2": steps.area,
+            "h_W_m2K": steps.h,
             "valid": valid,
-            "mask": mask.astype(str),
-            "in_mass_flow_window": in_window,
+            "mask": steps.mask.astype(str),
+            "in_mass_flow_window": window.in_window,
             "mean_air_temperature_C": scatter(numbers.mean_air_temperature_c),
             "reynolds": scatter(numbers.reynolds),
             "prandtl": scatter(numbers.prandtl),
@@ -627,8 +699,14 @@ def analyse_run(
         }
     )
 
+
+def _exchangers(
+    case: Case, h_mean: float, flow: float, dt_mean: float, case_path: Path, notes: list[str]
+) -> tuple[float, float, float, ExchangerResult, ExchangerResult | None]:
+    """The section's falling mass and area, the plant's exchanger area (Eqs. 41, 47-48), the
+    cooler model at that area, and the area for the plant's outlet temperature if given."""
     m_mf = flow * dt_mean
-    a_fp = float(falling_particle_area(m_mf, dp, rho))
+    a_fp = float(falling_particle_area(m_mf, case.particles.diameter, case.particles.density))
     a_he = exchanger_area_from_section(
         a_fp, cooler_length_m=case.plant.length, section_length_m=case.drum.length, dt_s=dt_mean
     )
@@ -647,28 +725,7 @@ def analyse_run(
             )
         except InfeasibleExchangerError as exc:
             notes.append(f"plant.material_outlet_temperature_C: {exc}")
-
-    return MethodologyResult(
-        run_dir=root,
-        case=case,
-        steps=table_out,
-        h_mean_w_m2k=h_mean,
-        falling_mass_mode=falling_mass,
-        falling_mass_flow_kg_s=flow,
-        falling_mass_window_s=window,
-        dt_s=dt_mean,
-        falling_mass_per_step_kg=m_mf,
-        air_mass_per_step_kg=case.air.mass_flow * dt_mean,
-        falling_area_m2=a_fp,
-        nusselt_conductivity=nusselt_conductivity,
-        void_fraction=numbers.void_fraction,
-        air_inlet_velocity_m_s=numbers.air_inlet_velocity_m_s,
-        max_air_velocity_m_s=numbers.max_air_velocity_m_s,
-        exchanger_area_m2=a_he,
-        exchanger=model,
-        plant_exchanger=plant_result,
-        warnings=tuple(notes),
-    )
+    return m_mf, a_fp, a_he, model, plant_result
 
 
 def write_methodology(run_dir: Path | str, result: MethodologyResult) -> tuple[Path, Path]:
@@ -686,9 +743,8 @@ def write_methodology(run_dir: Path | str, result: MethodologyResult) -> tuple[P
     tuple of pathlib.Path
         The JSON file and the CSV file.
     """
-    root = Path(run_dir).resolve()
-    json_path = root / METHODOLOGY_FILE
-    csv_path = root / STEPS_FILE
+    run = RunDir(run_dir, create=False)
+    json_path, csv_path = run.methodology_json, run.steps_csv
     json_path.parent.mkdir(parents=True, exist_ok=True)
     json_path.write_text(json.dumps(result.to_dict(), indent=2, allow_nan=False) + "\n")
     result.steps.to_csv(csv_path, index=False, float_format="%.10g")

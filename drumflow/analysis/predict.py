@@ -42,9 +42,24 @@ scales from that reference:
    feed rate and air flow. ``T_mo`` comes from
    :func:`~drumflow.analysis.exchanger.solve_outlet_temperature`.
 
-Range. The correlation is empirical. The paper's correlation is valid for 3073 < Re < 7686
-(Figure 9, :data:`PAPER_REYNOLDS_RANGE`), and a fitted :class:`NusseltCorrelation` carries its
-own range. A prediction whose ``Re`` leaves that range gets a :class:`CorrelationRangeWarning`
+Range. The correlation is empirical. A fitted :class:`NusseltCorrelation` carries its own range,
+in the Re it was fitted with: drumflow's, Eqs. 51-54 as printed (the mean inlet velocity over
+the whole drum cross-section, divided by the void factor).
+
+One definition of Re. The paper's correlation (Eq. 58) is valid for 3073 < Re < 7686
+(:data:`PAPER_REYNOLDS_RANGE`), but in the paper's own Re: its two models give 3073 and 7686
+where Eqs. 51-54 give drumflow 1844 and 4609, the same ratio 1.667 for both (the paper's Re
+implies v_max = 6.23 m/s; drumflow's V_ai / Vf is 3.74 m/s;
+:func:`drumflow.analysis.paper.reynolds_conversion`). Every Re that :func:`predict_plant`
+computes and compares is drumflow's. The paper's correlation enters only through
+:func:`paper_correlation`, which converts it to drumflow's definitions once: its range is
+``PAPER_REYNOLDS_RANGE / 1.667`` and its coefficient is ``a 1.667^b (0.7282 / 0.7066)^c`` (the
+second factor converts the paper's Pr of air at 30 deg C, from another property table, to
+drumflow's), so that at drumflow's Re and Pr of a paper model it returns the paper's Nu.
+:data:`PAPER_CORRELATION` and :data:`PAPER_REYNOLDS_RANGE` keep the published numbers and must
+not be compared with drumflow's Re directly.
+
+A prediction whose ``Re`` leaves the correlation's range gets a :class:`CorrelationRangeWarning`
 in ``Prediction.range_warnings`` and a message in ``Prediction.warnings``. So does a ``Pr`` more
 than 1 % outside the fitted ``Pr`` range. The function itself emits no Python warning, so that
 a batch of predictions can be collected and reported.
@@ -53,38 +68,85 @@ a batch of predictions can be collected and reported.
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from typing import Any, Literal
 
-from drumflow.analysis import air_properties as air
+from drumflow import air_properties as air
 from drumflow.analysis._validate import AnalysisInputError, check_positive
 from drumflow.analysis.correlation import CorrelationRangeWarning, NusseltCorrelation
-from drumflow.analysis.dimensionless import drum_volume, mean_air_inlet_velocity, particle_volume
+from drumflow.analysis.dimensionless import (
+    drum_volume,
+    mean_air_inlet_velocity,
+    particle_volume,
+)
 from drumflow.analysis.exchanger import ExchangerResult, solve_outlet_temperature
 from drumflow.analysis.heat_transfer import falling_particle_area
 from drumflow.analysis.methodology import (
     MethodologyResult,
     _json_safe,
     exchanger_to_dict,
-    plant_streams,
 )
 from drumflow.case import Case
 
 __all__ = [
     "ASSUMPTIONS",
     "PAPER_CORRELATION",
+    "PAPER_PLANT",
     "PAPER_REYNOLDS_RANGE",
     "CorrelationRangeWarning",
     "OperatingPoint",
+    "PlantSpec",
     "Prediction",
+    "paper_correlation",
     "predict_plant",
 ]
 
 PAPER_REYNOLDS_RANGE: tuple[float, float] = (3073.0, 7686.0)
-"""Validity range of the paper's correlation, Eq. 58 and Figure 9."""
+"""Validity range of the paper's correlation, Eq. 58 and Figure 9, as published: in the paper's
+Re, 1.667 times drumflow's (module notes). Compare drumflow's Re with
+``paper_correlation().reynolds_range`` instead."""
 
 PAPER_CORRELATION: tuple[float, float, float] = (0.0531283, 0.523707, 1.00824)
-"""``(a, b, c)`` of the paper's Eq. 58 (fitted with the particle conductivity in Nu)."""
+"""``(a, b, c)`` of the paper's Eq. 58 as published (the particle conductivity in Nu, the
+paper's Re and Pr); :func:`paper_correlation` gives it in drumflow's definitions."""
+
+
+def paper_correlation() -> NusseltCorrelation:
+    """The paper's Eq. 58 in drumflow's definitions of Re and Pr (module notes).
+
+    ``Nu = a' Re^b Pr^c`` with ``a' = a f_Re^b f_Pr^c``, ``f_Re = Re_paper / Re_drumflow``
+    (1.667, from the paper's two models) and ``f_Pr = 0.7282 / Pr_drumflow(30 C)``; the Re range
+    is the published one divided by ``f_Re``, the Pr range drumflow's Pr at 30 deg C. Nu uses
+    the particle conductivity (``nusselt_conductivity="particle"`` in :func:`predict_plant`).
+    The ANOVA is the paper's Table 8; the paper gives no standard errors (NaN here).
+
+    Returns
+    -------
+    NusseltCorrelation
+    """
+    from drumflow.analysis.correlation import anova_table
+    from drumflow.analysis.paper import EQ58, reynolds_conversion
+
+    conv = reynolds_conversion()
+    a, b, c = PAPER_CORRELATION
+    a_df = a * conv.factor**b * conv.prandtl_factor**c
+    pr = conv.per_model["one"]["prandtl_drumflow"]
+    nan_ci = (math.nan, math.nan)
+    ms_error = 0.000844  # Table 8
+    return NusseltCorrelation(
+        a=a_df, b=b, c=c, se_a=math.nan, se_b=math.nan, se_c=math.nan,
+        ci_a=nan_ci, ci_b=nan_ci, ci_c=nan_ci, prandtl_exponent_fitted=True,
+        note=(f"the paper's Eq. 58 in drumflow's Re and Pr: a = {a:g} x {conv.factor:.4f}^{b:g} x "
+              f"{conv.prandtl_factor:.4f}^{c:g} = {a_df:.6g}; Re range "
+              f"{PAPER_REYNOLDS_RANGE[0]:g}-{PAPER_REYNOLDS_RANGE[1]:g} / {conv.factor:.4f}"),
+        n=int(EQ58["observations"]), n_params=3, n_dropped=0,
+        anova=anova_table(58470.6, 4.05118, int(EQ58["observations"]), 3),
+        r_squared=math.nan, adjusted_r_squared=float(EQ58["adjusted_r2"]),
+        residual_std=math.sqrt(ms_error),
+        reynolds_range=(conv.to_drumflow(PAPER_REYNOLDS_RANGE[0]),
+                        conv.to_drumflow(PAPER_REYNOLDS_RANGE[1])),
+        prandtl_range=(pr, pr),
+    )
 
 # A fit on per-step data spans only the Pr of the per-step air temperatures, a few hundredths
 # of a kelvin wide, so a strict Pr test would flag every prediction. Air Pr changes by about 1 %
@@ -101,7 +163,9 @@ ASSUMPTIONS: tuple[str, ...] = (
     "Solids volume of the section scales with the feed rate (hold-up at fixed residence time); "
     "Dp at equal hold-up mass keeps it; the void fraction follows (Eq. 53).",
     "Air inlet velocity is proportional to the air mass flow (density at T_ai, full drum "
-    "cross-section); v_max = V_ai / Vf; Re = v_max Dp / nu (Eqs. 51-52).",
+    "cross-section); v_max = V_ai / Vf; Re = v_max Dp / nu (Eqs. 51-52). This is drumflow's Re "
+    "throughout; the paper's Re is 1.667 times it, and its Eq. 58 enters converted "
+    "(paper_correlation).",
     "Air properties at one temperature: the reference run's mean T_ma, else T_ai; the per-step "
     "air warming is not rescaled.",
     "h = Nu k / Dp with the conductivity the correlation was fitted with; a fixed h is used "
@@ -131,6 +195,113 @@ class OperatingPoint:
     air_mass_flow_kg_s: float
     feed_rate_kg_s: float
     particle_diameter_m: float
+
+
+@dataclass(frozen=True)
+class PlantSpec:
+    """The full-scale cooler: the one definition of the plant that ``drumflow predict`` (the
+    paper's exchanger scaled by a correlation) and ``drumflow cooler drum`` (the axial cell
+    model) both use.
+
+    Attributes
+    ----------
+    diameter_m, length_m, rpm, tilt_deg
+        Drum inner diameter and length (m), rotation speed (1/min), axis tilt (degrees).
+    feed_rate_kg_s, material_inlet_temperature_c
+        Material stream.
+    air_mass_flow_kg_s, air_inlet_temperature_c, air_heat_capacity_j_kgk
+        Air stream (counter-current).
+    particle_diameter_m, particle_density_kg_m3, particle_heat_capacity_j_kgk,
+    particle_conductivity_w_mk
+        The granules.
+    residence_time_s
+        Measured mean solids residence time (the transport law's calibration point), or None.
+    measured_material_outlet_c, measured_air_outlet_c
+        The plant's measured outlets, reported beside predictions, never fitted to.
+    """
+
+    diameter_m: float
+    length_m: float
+    rpm: float
+    tilt_deg: float
+    feed_rate_kg_s: float
+    material_inlet_temperature_c: float
+    air_mass_flow_kg_s: float
+    air_inlet_temperature_c: float
+    particle_diameter_m: float
+    particle_density_kg_m3: float
+    particle_heat_capacity_j_kgk: float
+    particle_conductivity_w_mk: float
+    air_heat_capacity_j_kgk: float = 1005.0
+    residence_time_s: float | None = None
+    measured_material_outlet_c: float | None = None
+    measured_air_outlet_c: float | None = None
+
+    @classmethod
+    def from_case(cls, case: Case) -> PlantSpec:
+        """The plant of a slice case: its drum cross-section and air, ``plant`` section."""
+        p = case.particles
+        return cls(
+            diameter_m=float(case.drum.diameter),
+            length_m=float(case.plant.length),
+            rpm=float(case.drum.rpm),
+            tilt_deg=float(case.drum.tilt_deg),
+            feed_rate_kg_s=float(case.plant.material_mass_flow),
+            material_inlet_temperature_c=float(case.plant.material_inlet_temperature_C),
+            air_mass_flow_kg_s=float(case.air.mass_flow),
+            air_inlet_temperature_c=float(case.air.inlet_temperature_C),
+            particle_diameter_m=float(p.diameter),
+            particle_density_kg_m3=float(p.density),
+            particle_heat_capacity_j_kgk=float(p.heat_capacity),
+            particle_conductivity_w_mk=float(p.conductivity),
+            air_heat_capacity_j_kgk=float(case.air.heat_capacity),
+            measured_material_outlet_c=case.plant.material_outlet_temperature_C,
+        )
+
+    def operating_point(self) -> OperatingPoint:
+        """The variables a prediction can change, at this plant's values."""
+        return OperatingPoint(
+            rpm=self.rpm,
+            air_mass_flow_kg_s=self.air_mass_flow_kg_s,
+            feed_rate_kg_s=self.feed_rate_kg_s,
+            particle_diameter_m=self.particle_diameter_m,
+        )
+
+    def streams(self) -> dict[str, float]:
+        """Keyword arguments of the exchanger functions (Eqs. 42-48) for this plant."""
+        return {
+            "material_mass_flow_kg_s": self.feed_rate_kg_s,
+            "material_cp_j_kgk": self.particle_heat_capacity_j_kgk,
+            "material_inlet_temperature_c": self.material_inlet_temperature_c,
+            "air_mass_flow_kg_s": self.air_mass_flow_kg_s,
+            "air_cp_j_kgk": self.air_heat_capacity_j_kgk,
+            "air_inlet_temperature_c": self.air_inlet_temperature_c,
+        }
+
+    def changed(self, **changes: float | None) -> PlantSpec:
+        """A copy with some fields changed (``None`` values keep the current one)."""
+        return replace(self, **{k: v for k, v in changes.items() if v is not None})
+
+
+PAPER_PLANT = PlantSpec(
+    diameter_m=3.0,
+    length_m=19.0,
+    rpm=5.0,
+    tilt_deg=1.5,
+    feed_rate_kg_s=13.88889,
+    material_inlet_temperature_c=90.0,
+    air_mass_flow_kg_s=25.0,
+    air_inlet_temperature_c=30.0,
+    particle_diameter_m=2.7e-3,
+    particle_density_kg_m3=1050.0,
+    particle_heat_capacity_j_kgk=1465.38,
+    particle_conductivity_w_mk=0.18596,
+    air_heat_capacity_j_kgk=1005.0,
+    residence_time_s=30.0 * 60.0,
+    measured_material_outlet_c=46.5,
+    measured_air_outlet_c=59.0,
+)
+"""The paper's industrial cooler (Burgos-Florez et al. 2019, Section 3.1 and Table 1)."""
 
 
 @dataclass(frozen=True)
@@ -339,12 +510,8 @@ def predict_plant(
             "a NusseltCorrelation or a heat-transfer coefficient in W/(m2 K)",
         )
 
-    ref = OperatingPoint(
-        rpm=float(case.drum.rpm),
-        air_mass_flow_kg_s=float(case.air.mass_flow),
-        feed_rate_kg_s=float(case.plant.material_mass_flow),
-        particle_diameter_m=float(case.particles.diameter),
-    )
+    plant = PlantSpec.from_case(case)
+    ref = plant.operating_point()
     new = OperatingPoint(
         rpm=ref.rpm if rpm is None else check_positive("rpm", rpm),
         air_mass_flow_kg_s=ref.air_mass_flow_kg_s
@@ -440,11 +607,11 @@ def predict_plant(
     exchanger = solve_outlet_temperature(
         h_w_m2k=h_new,
         area_m2=a_new,
-        **plant_streams(case, feed_rate_kg_s=new.feed_rate_kg_s,
-                        air_mass_flow_kg_s=new.air_mass_flow_kg_s),
+        **plant.changed(feed_rate_kg_s=new.feed_rate_kg_s,
+                        air_mass_flow_kg_s=new.air_mass_flow_kg_s).streams(),
     )
     reference_exchanger = solve_outlet_temperature(
-        h_w_m2k=h_ref, area_m2=a_ref, **plant_streams(case)
+        h_w_m2k=h_ref, area_m2=a_ref, **plant.streams()
     )
     return Prediction(
         h_source="correlation" if correlation is not None else "fixed",

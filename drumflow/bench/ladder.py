@@ -127,7 +127,8 @@ def apply_rung(case: Case, rung: Rung) -> Case:
     p = data["particles"]
     if rung.modulus_scale is not None:
         p["youngs_modulus"] = case.particles.youngs_modulus * rung.modulus_scale
-        p["youngs_modulus_reference"] = case.particles.youngs_modulus_reference or case.particles.youngs_modulus
+        p["youngs_modulus_reference"] = (case.particles.youngs_modulus_reference
+                                         or case.particles.youngs_modulus)
     if rung.size_scale is not None:
         s = rung.size_scale
         p["diameter"] = case.particles.diameter * s
@@ -157,6 +158,7 @@ def select(rungs: list[Rung], names: list[str] | None, speed_only: bool = False)
 
 def relative_error(value: float, reference: float) -> float:
     """|value - reference| / |reference| (NaN when either is missing or the reference is 0)."""
-    if value is None or reference is None or not math.isfinite(value) or not math.isfinite(reference) or reference == 0:
+    if (value is None or reference is None or not math.isfinite(value)
+            or not math.isfinite(reference) or reference == 0):
         return math.nan
     return abs(value - reference) / abs(reference)

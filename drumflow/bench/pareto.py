@@ -64,9 +64,11 @@ def plot_pareto(table: pd.DataFrame, path: Path, tolerances: dict[str, float], t
     noise = ok[ok["rung"] == "mpi_2"]["error_over_tolerance"]
     if len(noise) and pd.notna(noise.iloc[0]) and noise.iloc[0] > 0:
         # Same physics, different round-off: below this line differences are chaos, not error.
-        ax.axhline(float(noise.iloc[0]), color="0.5", lw=1, ls=":", label="noise floor (mpi_2: round-off only)")
+        ax.axhline(float(noise.iloc[0]), color="0.5", lw=1, ls=":",
+                   label="noise floor (mpi_2: round-off only)")
     ax.axhline(1.0, color="tab:red", lw=1, ls="--",
-               label=f"tolerance (T, h {tolerances['temperature']:.0%}; mass flow {tolerances['mass_flow']:.0%})")
+               label=(f"tolerance (T, h {tolerances['temperature']:.0%}; "
+                      f"mass flow {tolerances['mass_flow']:.0%})"))
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.set_xlabel("DEM wall time (s)")

@@ -31,8 +31,10 @@ from typing import Any, Protocol
 import numpy as np
 from numpy.typing import NDArray
 
+from drumflow.coupling.crossings import CrossingTracker
 from drumflow.coupling.library import Liggghts
 from drumflow.coupling.physics import AirState, convective_heat, drag_force
+from drumflow.coupling.stop import StopMonitor
 
 #: Per-atom properties the deck defines for the drag (``fix addforce`` reads them).
 DRAG_FIXES = ("air_fx", "air_fy", "air_fz")
@@ -52,7 +54,12 @@ class UniformAir:
         return np.broadcast_to(np.asarray(self.velocity, float), (len(points), 3))
 
 
-def air_velocity_at(field: VelocityField, x: NDArray[np.float64], time_s: float, omega: float) -> NDArray[np.float64]:
+def air_velocity_at(
+    field: VelocityField,
+    x: NDArray[np.float64],
+    time_s: float,
+    omega: float,
+) -> NDArray[np.float64]:
     """Air velocity at lab-frame positions at time t.
 
     A field solved in the drum's rotating frame (MRF) turns with the drum: a lab position maps
@@ -96,7 +103,8 @@ def _finalize_mpi() -> None:
 
 
 def run(spec_path: Path) -> int:
-    """Run the coupled loop described by a JSON spec (see :func:`drumflow.dem.coupled_spec`)."""
+    """Run the coupled loop described by a JSON spec (written by
+    :meth:`drumflow.coupling.spec.CouplingSpec.write_driver_file`)."""
     spec = json.loads(spec_path.read_text())
     work = spec_path.parent
     os.chdir(work)
@@ -114,6 +122,17 @@ def run(spec_path: Path) -> int:
     log_path = Path(spec["coupling_log"].format(rank=rank, start=start))
     log_path.parent.mkdir(parents=True, exist_ok=True)
     rows: list[tuple[float, ...]] = []
+    # run.stop = "converged": leave the loop once h and the falling mass flow are known well
+    # enough (drumflow.coupling.stop); absent for a fixed-time run, which is unchanged.
+    monitor = StopMonitor(spec["stop"], work, rank, dt, start) if spec.get("stop") else None
+    # run.crossings = "loop": find the axis-plane crossings here, with the particles in memory,
+    # instead of LIGGGHTS' band dump (drumflow.coupling.crossings); the stop rule counts them.
+    record_crossings = spec.get("crossings") == "loop"
+    if record_crossings:
+        lmp.command("undump cross")
+    tracker = (CrossingTracker(int(spec["particles"]), work, rank, record_crossings, start * dt)
+               if monitor is not None or record_crossings else None)
+    stopped = False
     with log_path.open("w") as out:
         out.write("step,time_s,steps,heat_to_particles_W,drag_x_N,drag_y_N,drag_z_N,particles,mean_slip_m_s\n")
         while step < total:
@@ -125,6 +144,13 @@ def run(spec_path: Path) -> int:
             u = air_velocity_at(field, x, step * dt, omega)
             force = drag_force(u, v, d, air)
             heat = convective_heat(u, v, T, d, air)
+            found = tracker.update(lmp, step * dt) if tracker is not None else None
+            if monitor is not None and monitor.observe(step, n, heat, d, T,
+                                                       lmp.atom_vector("rmass"), found):
+                # Before this update's heat is applied or logged: the heat log stays exactly
+                # what LIGGGHTS received.
+                stopped = True
+                break
             for k, name in enumerate(DRAG_FIXES):
                 lmp.fix_vector(name)[:] = force[:, k]
             lmp.fix_vector("heatSource")[:] = heat
@@ -140,6 +166,13 @@ def run(spec_path: Path) -> int:
             # need not rebuild neighbour lists or re-initialise the fixes (the loop's cost).
             lmp.command(f"run {n} pre no post no")
             step += n
+    if tracker is not None:
+        if not stopped:
+            # The crossings of the last interval, up to the final step.
+            tracker.update(lmp, step * dt)
+        tracker.close()
+    if monitor is not None:
+        monitor.finish(step, stopped)
     for command in spec.get("tail", []):
         lmp.command(command)
     lmp.close()

@@ -33,7 +33,8 @@ class Liggghts:
             lib = C.CDLL(LIBRARY, mode=C.RTLD_GLOBAL)
         except OSError as exc:
             raise SolverNotFoundError(
-                "liggghts", [LIBRARY], None, None, reason=f"{LIBRARY} not found ({exc}); run scripts/install.sh"
+                "liggghts", [LIBRARY], None, None,
+                reason=f"{LIBRARY} not found ({exc}); run scripts/install.sh"
             ) from None
         lib.lammps_open_no_mpi.argtypes = [C.c_int, C.POINTER(C.c_char_p), C.POINTER(C.c_void_p)]
         lib.lammps_command.argtypes = [C.c_void_p, C.c_char_p]

@@ -19,9 +19,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import brentq
 
-from drumflow.analysis import air_properties as air_table
-
-R_AIR = 287.05  # J/(kg K), specific gas constant of dry air
+from drumflow import air_properties as air_table
 
 
 @dataclass(frozen=True)
@@ -37,7 +35,7 @@ class AirState:
     @classmethod
     def at(cls, temperature_C: float, pressure_kPa: float = 101.325) -> AirState:
         """Air at a temperature (Incropera Table A.4 for mu, k, Pr; ideal gas for rho)."""
-        rho = pressure_kPa * 1e3 / (R_AIR * (temperature_C + 273.15))
+        rho = air_table.ideal_gas_density(temperature_C, pressure_kPa)
         return cls(
             temperature_C=temperature_C,
             density=rho,

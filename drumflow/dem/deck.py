@@ -1,4 +1,4 @@
-"""Render the LIGGGHTS input deck from ``templates/`` for a case.
+"""Render the LIGGGHTS input deck from the package templates (``drumflow/dem/templates/``).
 
 The template knows LIGGGHTS' syntax; this module only computes the values that go into it
 (material tables, gravity vector, step counts), so the physics stays testable without a solver.
@@ -9,15 +9,14 @@ from __future__ import annotations
 import math
 import os
 from dataclasses import dataclass
-from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import jinja2
 
-from drumflow.dem.timestep import TimeStepChoice
 from drumflow.dem.conduction import liggghts_conductivity
 from drumflow.dem.restitution import calibrate_case
 from drumflow.dem.stability import CHECK_EVERY_STEPS
+from drumflow.dem.timestep import TimeStepChoice
 
 if TYPE_CHECKING:
     from drumflow.case import Case
@@ -26,17 +25,21 @@ if TYPE_CHECKING:
 SOFT_PARTICLE_LIMIT = 5.0e6
 
 
-def templates_dir() -> Path:
-    """The folder with the deck templates (``DRUMFLOW_TEMPLATES`` overrides it)."""
+def _loader() -> jinja2.BaseLoader:
+    """The shipped templates (package data), or ``DRUMFLOW_TEMPLATES`` when set.
+
+    Package data is read through jinja2's :class:`~jinja2.PackageLoader` (importlib
+    resources), so an installed wheel finds the templates as well as an editable checkout.
+    """
     env = os.environ.get("DRUMFLOW_TEMPLATES")
     if env:
-        return Path(env)
-    return Path(__file__).resolve().parents[2] / "templates"
+        return jinja2.FileSystemLoader(env)
+    return jinja2.PackageLoader("drumflow.dem", "templates")
 
 
 def _environment() -> jinja2.Environment:
     return jinja2.Environment(
-        loader=jinja2.FileSystemLoader(str(templates_dir())),
+        loader=_loader(),
         undefined=jinja2.StrictUndefined,  # a missing value is an error, never an empty string
         keep_trailing_newline=True,
         trim_blocks=True,
@@ -119,9 +122,9 @@ def gravity_vector(tilt_deg: float) -> tuple[float, float, float]:
     return (0.0, -math.cos(t), math.sin(t))
 
 
-def processors_grid(case: Case) -> str:
+def processors_grid(case: Case, processes: int) -> str:
     """MPI decomposition: along the axis for long sections, across it for thin slices."""
-    n = case.process_count
+    n = processes
     if n == 1:
         return "1 1 1"
     if case.drum.length >= case.drum.diameter:
@@ -144,10 +147,13 @@ def deck_context(
     resume_from: str | None = None,
     extra_commands: str = "",
     coupled: bool = False,
+    processes: int = 1,
 ) -> dict[str, Any]:
     """All values the template needs.
 
-    ``extra_commands`` are LIGGGHTS lines placed just before the run (verification scenes).
+    ``extra_commands`` are LIGGGHTS lines placed just before the run (verification scenes);
+    ``processes`` is the MPI process count the domain is decomposed for (from the launch
+    profile, :meth:`drumflow.runner.LaunchProfile.processes_for`).
     """
     p = case.particles
     cc = case.contacts
@@ -155,7 +161,7 @@ def deck_context(
     E_wall = cc.wall_youngs_modulus if cc.wall_youngs_modulus is not None else p.youngs_modulus
     return {
         "case_name": case.name,
-        "processors": processors_grid(case),
+        "processors": processors_grid(case, processes),
         "soft_particles": min(p.youngs_modulus, E_wall) < SOFT_PARTICLE_LIMIT,
         "resume": resume_from is not None,
         "restart_file": resume_from or "",
@@ -176,7 +182,9 @@ def deck_context(
         # LIGGGHTS' conduction is sqrt(2 pi) times Eq. 24's for the same k (a pure geometric
         # factor: sqrt of the overlap area against the Hertzian contact radius), and k enters
         # linearly, so LIGGGHTS gets k / sqrt(2 pi). See drumflow.verify.contacts.
-        "k_particle": f"{liggghts_conductivity(p.conductivity):.9g}",
+        # run.conduction = false: zero conductivity, the one way to switch contact conduction
+        # off in LIGGGHTS 3.8 (drum.in.j2).
+        "k_particle": f"{liggghts_conductivity(p.conductivity) if case.run.conduction else 0.0:.9g}",
         # Softened for speed: the conduction contact area still refers to the real modulus.
         "E_reference_particle": f"{p.youngs_modulus_reference or p.youngs_modulus:.9g}",
         "E_reference_wall": f"{(cc.wall_youngs_modulus or p.youngs_modulus_reference or E_wall):.9g}",

@@ -59,7 +59,8 @@ def impact_overlap(speed: float, effective_mass: float, effective_radius: float,
 
     delta_max = (15 m* v^2 / (16 E* sqrt(R*)))^(2/5).
     """
-    return (15.0 * effective_mass * speed**2 / (16.0 * effective_modulus * math.sqrt(effective_radius))) ** 0.4
+    ratio = 15.0 * effective_mass * speed**2 / (16.0 * effective_modulus * math.sqrt(effective_radius))
+    return ratio**0.4
 
 
 def bed_depth(case: Case) -> float:
@@ -151,7 +152,8 @@ class StabilityMonitor:
         also_lost = f"; {lost} of {lim.particles} particles already left the drum" if lost > 0 else ""
         values = [ke, ke_rot] + ([overlap] if overlap is not None else [])
         if not all(math.isfinite(x) for x in values):
-            return f"non-finite kinetic energy or overlap {when}: the integration has diverged{also_lost}." + cause
+            return (f"non-finite kinetic energy or overlap {when}: the integration has "
+                    f"diverged{also_lost}." + cause)
         energy = ke + ke_rot
         self.max_kinetic_energy = max(self.max_kinetic_energy, energy)
         if energy > lim.kinetic_energy_limit:

@@ -29,6 +29,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from drumflow.air_properties import ideal_gas_density
 from drumflow.errors import GeometryError
 
 if TYPE_CHECKING:
@@ -214,14 +215,9 @@ def bulk_velocity(case: Case, area: float | None = None) -> float:
     return case.air.mass_flow / (air_density(case) * area)
 
 
-#: Specific gas constant of dry air, J/(kg K).
-R_AIR = 287.05
-
-
 def air_density(case: Case) -> float:
     """Ideal-gas air density at the inlet, rho = p / (R_air T), kg/m^3.
 
     The air is treated as incompressible at this density (the paper: "constant density gas").
     """
-    T = case.air.inlet_temperature_C + 273.15
-    return case.air.pressure_kPa * 1e3 / (R_AIR * T)
+    return ideal_gas_density(case.air.inlet_temperature_C, case.air.pressure_kPa)

@@ -17,7 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 if TYPE_CHECKING:
-    from drumflow.case import Lifters
+    from drumflow.case import Case, Lifters
 
 #: How far the base plate reaches past the shell, as a multiple of its thickness. The overlap
 #: makes the boolean cut of lifters from the drum disk clean (no sliver faces at the shell).
@@ -143,3 +143,8 @@ def lifter_area(radius: float, lifters: Lifters) -> float:
     if lifters.profile != "straight":
         per += lifters.lip_length * t
     return lifters.count * per
+
+
+def free_area(case: Case) -> float:
+    """Cross-section open to the air: the shell's disk minus the lifters, m^2."""
+    return math.pi * case.drum.radius**2 - lifter_area(case.drum.radius, case.lifters)

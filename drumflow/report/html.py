@@ -13,7 +13,9 @@ offline. It holds:
   Nu against Re with the fitted curve (Figure 9).
 
 Nothing stops the page from being written. A run without air (no ``h``), a missing file or a
-failed render gives a note in its place. Only a run directory that does not exist is an error.
+failed render gives a note in its place. Only a path that is not a run directory (missing, or
+without a case file and a manifest) is an error. Every path comes from
+:class:`~drumflow.rundir.RunDir`.
 """
 
 from __future__ import annotations
@@ -32,11 +34,8 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from drumflow.analysis._validate import AnalysisInputError
 from drumflow.analysis.correlation import NusseltCorrelation
 from drumflow.analysis.methodology import (
-    CASE_FILE,
-    MEAN_TEMPERATURE_FILE,
     FallingMassMode,
     MethodologyResult,
     NusseltConductivity,
@@ -44,7 +43,13 @@ from drumflow.analysis.methodology import (
     fit_runs,
 )
 from drumflow.case import Case, load_case
-from drumflow.errors import DrumflowError, RunDirectoryError
+from drumflow.errors import (
+    AnalysisInputError,
+    DrumflowError,
+    RenderError,
+    RunDirectoryError,
+)
+from drumflow.rundir import RunDir
 
 __all__ = ["write_report"]
 
@@ -190,13 +195,13 @@ def _summary_table(summary: dict[str, Any]) -> _Table:
     return _Table("Observables (summary.json)", ["quantity", "value"], rows)
 
 
-def _mean_temperature_figure(root: Path) -> _Figure:
+def _mean_temperature_figure(run: RunDir) -> _Figure:
     fig = _Figure("Mean particle temperature (Figures 7 and 8)")
-    png = _file_uri(root / "post" / "mean_temperature.png")
+    png = _file_uri(run.mean_temperature_plot)
     if png is not None:
         fig.uri = png
         return fig
-    csv = root / MEAN_TEMPERATURE_FILE
+    csv = run.mean_temperature_csv
     try:
         table = pd.read_csv(csv)
         t = table["time_s"].to_numpy(dtype=float)
@@ -212,7 +217,8 @@ def _mean_temperature_figure(root: Path) -> _Figure:
         ax.grid(alpha=0.3)
 
     fig.uri = _fig_uri(draw)
-    fig.caption = f"from {MEAN_TEMPERATURE_FILE} (no mean_temperature.png in the run)"
+    fig.caption = (f"from {csv.relative_to(run.root)} (no {run.mean_temperature_plot.name} "
+                   "in the run)")
     return fig
 
 
@@ -243,18 +249,18 @@ def _h_figure(result: MethodologyResult) -> _Figure:
     return _Figure("Heat-transfer coefficient per step (Eqs. 34-41)", caption, _fig_uri(draw))
 
 
-def _particles_figure(root: Path, case: Case, manifest: dict[str, Any] | None,
+def _particles_figure(run: RunDir, case: Case, manifest: dict[str, Any] | None,
                       render_3d: bool, timeout_s: float) -> _Figure:
     fig = _Figure("Particles coloured by temperature, last snapshot (Figure 6)")
     if not render_3d:
         fig.note = "3-D rendering was switched off for this report"
         return fig
     from drumflow.dem.dumps import dump_files, read_dump
-    from drumflow.report.render import RenderError, render_particles_isolated
+    from drumflow.report.render import render_particles_isolated
 
-    files = dump_files(root / "dem" / "dumps", "snap")
+    files = dump_files(run.dem_dumps, "snap")
     if not files:
-        fig.note = f"no particle snapshot in {root / 'dem' / 'dumps'} (snap.*.txt)"
+        fig.note = f"no particle snapshot in {run.dem_dumps} (snap.*.txt)"
         return fig
     try:
         snap = read_dump(files[-1])
@@ -281,45 +287,45 @@ def _particles_figure(root: Path, case: Case, manifest: dict[str, Any] | None,
     return fig
 
 
-def _run_view(i: int, root: Path, result: MethodologyResult | None, why_not: str | None,
+def _run_view(i: int, run: RunDir, result: MethodologyResult | None, why_not: str | None,
               render_3d: bool, timeout_s: float) -> _RunView:
     case: Case | None = result.case if result is not None else None
     notes: list[str] = []
     if case is None:
         try:
-            case = load_case(root / CASE_FILE)
+            case = load_case(run.case_toml)
         except DrumflowError as exc:
             notes.append(f"case not available: {exc}")
-    name = case.name if case is not None else root.name
-    view = _RunView(name=name, path=str(root), anchor=_anchor(i, name), notes=notes)
+    name = case.name if case is not None else run.root.name
+    view = _RunView(name=name, path=str(run.root), anchor=_anchor(i, name), notes=notes)
     if why_not:
         view.notes.append(f"heat-transfer methodology not applied: {why_not}")
     if result is not None:
         view.notes.extend(result.warnings)
     if case is not None:
         view.tables.append(_case_table(case))
-    summary = _read_json(root / "summary.json")
+    summary = _read_json(run.summary_path)
     if summary is not None:
         view.tables.append(_summary_table(summary))
     else:
-        view.notes.append(f"no summary: {root / 'summary.json'} is missing or not JSON")
-    manifest = _read_json(root / "manifest.json")
+        view.notes.append(f"no summary: {run.summary_path} is missing or not JSON")
+    manifest = _read_json(run.manifest_path)
     view.manifest_json = json.dumps(manifest, indent=2, sort_keys=False) if manifest else None
 
-    view.figures.append(_mean_temperature_figure(root))
+    view.figures.append(_mean_temperature_figure(run))
     if result is not None:
         view.figures.append(_h_figure(result))
     crossings = _Figure("Particles crossing the axis plane downwards (Figure 4)",
-                        uri=_file_uri(root / "post" / "crossings.png"))
+                        uri=_file_uri(run.crossings_plot))
     if crossings.uri is None:
-        crossings.note = f"no crossing plot: {root / 'post' / 'crossings.png'} is missing"
+        crossings.note = f"no crossing plot: {run.crossings_plot} is missing"
     view.figures.append(crossings)
     if case is not None:
-        view.figures.append(_particles_figure(root, case, manifest, render_3d, timeout_s))
-    section = _file_uri(root / "post" / "particles_final.png")
+        view.figures.append(_particles_figure(run, case, manifest, render_3d, timeout_s))
+    section = _file_uri(run.particles_plot)
     if section is not None:
         view.figures.append(_Figure("Cross-section at the end of the run", uri=section))
-    geometry = _file_uri(root / "geometry" / "cross_section.png")
+    geometry = _file_uri(run.geometry_picture)
     if geometry is not None:
         view.figures.append(_Figure("Drum and lifter geometry", uri=geometry))
     return view
@@ -406,7 +412,31 @@ def _table8(corr: NusseltCorrelation) -> list[_Table]:
             "sums of squares as in Statgraphics; R-squared against the corrected total."
         ),
     )
-    return [coef, anova]
+    serial = corr.serial
+    if serial is None:
+        return [coef, anova]
+    honest = _Table(
+        "Table 8b. The same fit with serially correlated time steps",
+        ["Parameter", "Estimate", "Std. error (independent steps)",
+         "Std. error (serial correlation)", "95 % confidence interval"],
+        [
+            [name, _fmt(value, 6), _fmt(naive, 3), _fmt(wide, 3), _fmt(ci, 5)]
+            for name, value, naive, wide, ci in (
+                ("a", corr.a, corr.se_a, serial.se_a, serial.ci_a),
+                ("b", corr.b, corr.se_b, serial.se_b, serial.ci_b),
+                ("c" + ("" if corr.prandtl_exponent_fitted else " (fixed)"), corr.c, corr.se_c,
+                 serial.se_c, serial.ci_c),
+            )
+        ],
+        note=(
+            f"Consecutive steps are not independent: lag-1 autocorrelation of the residuals "
+            f"{serial.lag1:.3f} (within each run), so the {corr.n:,} steps carry the information "
+            f"of about {serial.n_effective:.4g} independent ones (n (1 - rho) / (1 + rho)); the "
+            f"errors are {serial.inflation:.3g} times the table's, and the interval uses "
+            f"{serial.df_effective:.4g} degrees of freedom."
+        ),
+    )
+    return [coef, anova, honest]
 
 
 def _figure9(names: list[str], results: list[MethodologyResult | None],
@@ -482,88 +512,9 @@ def _comparison(names: list[str], results: list[MethodologyResult | None],
 
 # ------------------------------------------------------------------------------ template
 
-_TEMPLATE = """<!DOCTYPE html>
-<html lang="en">
-<head>
-<meta charset="utf-8">
-<meta name="viewport" content="width=device-width, initial-scale=1">
-<title>{{ title }}</title>
-<style>
-body { font-family: system-ui, -apple-system, "Segoe UI", Roboto, sans-serif; margin: 2em auto;
-       max-width: 1150px; padding: 0 1em; color: #222; line-height: 1.4; }
-h1 { font-size: 1.6em; border-bottom: 2px solid #c33; padding-bottom: .2em; }
-h2 { font-size: 1.3em; margin-top: 2em; border-bottom: 1px solid #ccc; }
-h3 { font-size: 1.05em; margin-top: 1.4em; }
-table { border-collapse: collapse; margin: .6em 0 1.2em; font-size: .9em; }
-caption { text-align: left; font-weight: 600; padding: .3em 0; }
-th, td { border: 1px solid #ccc; padding: .25em .6em; text-align: right; }
-th:first-child, td:first-child { text-align: left; }
-thead th { background: #f2f2f2; }
-tbody tr:nth-child(even) { background: #fafafa; }
-.note { background: #fff6e0; border-left: 4px solid #e0a000; padding: .4em .8em; margin: .6em 0; }
-.tnote { font-size: .85em; color: #555; margin-top: -.8em; }
-figure { margin: 1em 0 1.6em; }
-figure img { max-width: 100%; border: 1px solid #ddd; }
-figcaption { font-size: .85em; color: #555; }
-pre { background: #f6f6f6; padding: .8em; overflow-x: auto; font-size: .8em; }
-.meta { color: #666; font-size: .9em; }
-.eq { font-family: "Latin Modern Math", "STIX Two Math", serif; font-size: 1.1em; }
-</style>
-</head>
-<body>
-<h1>{{ title }}</h1>
-<p class="meta">drumflow {{ version }}, {{ generated }}. Method of Burgos-Florez et al.,
-Processes 2019, 7, 673 (Sections 2.2-2.5). Nu uses the {{ conductivity }} conductivity;
-falling mass per step: {{ falling_mass }}.</p>
-{% if runs|length > 1 %}<ul>{% for run in runs %}
-<li><a href="#{{ run.anchor }}">{{ run.name }}</a> <span class="meta">{{ run.path }}</span></li>
-{% endfor %}</ul>{% endif %}
-{% for note in notes %}<p class="note">{{ note }}</p>{% endfor %}
+#: The page template, shipped as package data (``drumflow/report/templates/``).
+TEMPLATE = "report.html.j2"
 
-{% macro table(t) -%}
-<table>
-<caption>{{ t.caption }}</caption>
-<thead><tr>{% for h in t.header %}<th>{{ h }}</th>{% endfor %}</tr></thead>
-<tbody>{% for row in t.rows %}
-<tr>{% for cell in row %}<td>{{ cell }}</td>{% endfor %}</tr>{% endfor %}
-</tbody>
-</table>
-{% if t.note %}<p class="tnote">{{ t.note }}</p>{% endif %}
-{%- endmacro %}
-
-{% macro figure(f) -%}
-<figure>
-<h3>{{ f.title }}</h3>
-{% if f.uri %}<img src="{{ f.uri }}" alt="{{ f.title }}">{% endif %}
-{% if f.note %}<p class="note">{{ f.note }}</p>{% endif %}
-{% if f.caption %}<figcaption>{{ f.caption }}</figcaption>{% endif %}
-</figure>
-{%- endmacro %}
-
-<h2>Heat transfer and exchanger model</h2>
-{% if comparison %}{{ table(comparison) }}{% endif %}
-{{ table(table6) }}
-{% if table7.header|length > 1 %}{{ table(table7) }}{% else %}
-<p class="note">Table 7 (exchanger model) is not available: no run could be analysed.</p>{% endif %}
-
-<h2>Correlation</h2>
-{% if table8 %}<p class="eq">{{ equation }}</p>{% for t in table8 %}{{ table(t) }}{% endfor %}
-{% else %}<p class="note">Table 8 (correlation and ANOVA) is not available: {{ no_fit }}</p>{% endif %}
-{{ figure(figure9) }}
-
-{% for run in runs %}
-<h2 id="{{ run.anchor }}">Run {{ run.name }}</h2>
-<p class="meta">{{ run.path }}</p>
-{% for note in run.notes %}<p class="note">{{ note }}</p>{% endfor %}
-{% for t in run.tables %}{{ table(t) }}{% endfor %}
-{% for f in run.figures %}{{ figure(f) }}{% endfor %}
-{% if run.manifest_json %}<details><summary>manifest.json</summary>
-<pre>{{ run.manifest_json }}</pre></details>
-{% else %}<p class="note">no manifest.json in this run directory</p>{% endif %}
-{% endfor %}
-</body>
-</html>
-"""
 
 
 def write_report(
@@ -600,16 +551,14 @@ def write_report(
     RunDirectoryError
         If no run directory is given or one of them is not a directory.
     """
-    from jinja2 import Environment, StrictUndefined
+    from jinja2 import Environment, PackageLoader, StrictUndefined
 
     import drumflow
 
-    roots = [Path(p).resolve() for p in run_dirs]
-    if not roots:
+    if not run_dirs:
         raise RunDirectoryError("no run directory given for the report")
-    for root in roots:
-        if not root.is_dir():
-            raise RunDirectoryError(f"{root}: not a directory (expected a `drumflow run` directory)")
+    runs = [RunDir.existing(p) for p in run_dirs]
+    roots = [run.root for run in runs]
 
     results: list[MethodologyResult | None] = []
     why_not: list[str | None] = []
@@ -624,8 +573,8 @@ def write_report(
             why_not.append(str(exc))
 
     views = [
-        _run_view(i, root, res, why, render_3d, render_timeout_s)
-        for i, (root, res, why) in enumerate(zip(roots, results, why_not, strict=True))
+        _run_view(i, run, res, why, render_3d, render_timeout_s)
+        for i, (run, res, why) in enumerate(zip(runs, results, why_not, strict=True))
     ]
     names = [v.name for v in views]
     ok = [r for r in results if r is not None]
@@ -656,9 +605,9 @@ def write_report(
         f"drumflow report: {names[0]}" if len(names) == 1
         else f"drumflow report: sweep of {len(names)} runs"
     )
-    env = Environment(autoescape=True, undefined=StrictUndefined, trim_blocks=True,
-                      lstrip_blocks=True)
-    html = env.from_string(_TEMPLATE).render(
+    env = Environment(loader=PackageLoader("drumflow.report", "templates"), autoescape=True,
+                      undefined=StrictUndefined, trim_blocks=True, lstrip_blocks=True)
+    html = env.get_template(TEMPLATE).render(
         title=title,
         version=drumflow.__version__,
         generated=time.strftime("%Y-%m-%d %H:%M:%S %z"),

@@ -42,12 +42,19 @@ def plot_mean_temperature(times: NDArray, T_mean: NDArray, path: Path, title: st
     plt.close(fig)
 
 
-def plot_crossings(crossings: pd.DataFrame, flow: FallingMassFlow, length: float, path: Path, title: str) -> None:
+def plot_crossings(
+    crossings: pd.DataFrame,
+    flow: FallingMassFlow,
+    length: float,
+    path: Path,
+    title: str,
+) -> None:
     """Crossing time against axial position (the paper's Figure 4), and the cumulative count."""
     plt = _plt()
     fig, (ax, ax2) = plt.subplots(1, 2, figsize=(9, 3.6), dpi=120, gridspec_kw={"width_ratios": [3, 2]})
     inwin = crossings["time"] >= flow.window_start_s
-    ax.scatter(crossings["time"][~inwin], crossings["z"][~inwin], s=6, color="0.7", lw=0, label="before window")
+    ax.scatter(crossings["time"][~inwin], crossings["z"][~inwin], s=6, color="0.7", lw=0,
+               label="before window")
     ax.scatter(crossings["time"][inwin], crossings["z"][inwin], s=6, color="tab:blue", lw=0, label="counted")
     ax.set_xlabel("crossing time (s)")
     ax.set_ylabel("axial position z (m)")

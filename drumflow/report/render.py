@@ -14,8 +14,6 @@ the cross-section is ``x``-``y`` centred on the axis, and gravity points along `
 from __future__ import annotations
 
 import json
-import os
-import subprocess
 import sys
 import tempfile
 from pathlib import Path
@@ -24,7 +22,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from drumflow.errors import DrumflowError
+from drumflow.errors import RenderError, SolverError, SolverTimeoutError
+from drumflow.runner import Runner
 
 __all__ = ["RenderError", "render_particles", "render_particles_isolated"]
 
@@ -33,10 +32,6 @@ _DEFAULT_WINDOW = (1000, 800)
 # particle diameter into a point size in pixels (render_points_as_spheres draws screen-space
 # discs of a fixed pixel size).
 _DRUM_SHARE_OF_HEIGHT = 0.8
-
-
-class RenderError(DrumflowError, RuntimeError):
-    """The particle picture could not be rendered (no OpenGL, crash, time limit, bad data)."""
 
 
 def _as_points(x: ArrayLike, y: ArrayLike, z: ArrayLike, T: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
@@ -154,9 +149,6 @@ def render_particles(
     return out
 
 
-_CHILD_CODE = "from drumflow.report.render import _child_main; _child_main()"
-
-
 def _child_main() -> None:
     """Entry point of the child process started by :func:`render_particles_isolated`."""
     import vtk
@@ -188,6 +180,7 @@ def render_particles_isolated(
     title: str | None = None,
     window_size: tuple[int, int] = _DEFAULT_WINDOW,
     timeout_s: float = 180.0,
+    runner: Runner | None = None,
 ) -> Path:
     """:func:`render_particles` in a child Python process with a time limit.
 
@@ -197,6 +190,8 @@ def render_particles_isolated(
         As for :func:`render_particles`.
     timeout_s
         Time limit for the child (s); it is killed when exceeded.
+    runner
+        Starts the child (default a fresh :class:`~drumflow.runner.Runner`).
 
     Returns
     -------
@@ -222,29 +217,33 @@ def render_particles_isolated(
     with tempfile.TemporaryDirectory(prefix="drumflow-render-") as tmp:
         npz = Path(tmp) / "particles.npz"
         np.savez(npz, x=pts[:, 0], y=pts[:, 1], z=pts[:, 2], T=temp)
+        # Through the runner like every other program: own process group (a hung VTK is
+        # killed whole at the time limit), output kept in a log for the error message.
+        log = Path(tmp) / "render.log"
+        runner = runner or Runner()
+        command = runner.profile.python_module_command("drumflow.report.render", str(npz), str(out),
+                                                       json.dumps(options))
         try:
-            proc = subprocess.run(
-                [sys.executable, "-c", _CHILD_CODE, str(npz), str(out), json.dumps(options)],
-                capture_output=True,
-                text=True,
-                timeout=timeout_s,
-                env=os.environ.copy(),
-                check=False,
-            )
-        except subprocess.TimeoutExpired:
+            runner.run("pyvista", command, Path(tmp), log, timeout=timeout_s)
+        except SolverTimeoutError:
             raise RenderError(
                 f"PyVista render did not finish within {timeout_s:g} s (off-screen OpenGL "
                 "unavailable or too slow)"
             ) from None
-    if proc.returncode != 0:
-        lines = [ln for ln in proc.stderr.splitlines() if ln.strip()]
-        last = lines[-1].strip() if lines else "no error output"
-        how = (
-            f"killed by signal {-proc.returncode}"
-            if proc.returncode < 0
-            else f"exit status {proc.returncode}"
-        )
-        raise RenderError(f"PyVista render failed ({how}): {last}")
+        except SolverError as exc:
+            # The log's first two lines are the runner's header.
+            lines = [ln for ln in log.read_text(errors="replace").splitlines()[2:] if ln.strip()]
+            last = lines[-1].strip() if lines else "no error output"
+            code = exc.returncode
+            how = (
+                f"killed by signal {-code}" if code is not None and code < 0
+                else f"exit status {code}"
+            )
+            raise RenderError(f"PyVista render failed ({how}): {last}") from None
     if not out.is_file() or out.stat().st_size == 0:
         raise RenderError(f"PyVista render wrote no picture at {out}")
     return out
+
+
+if __name__ == "__main__":
+    _child_main()

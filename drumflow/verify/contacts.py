@@ -37,7 +37,11 @@ from drumflow.dem.conduction import liggghts_conductivity
 from drumflow.dem.deck import SOFT_PARTICLE_LIMIT, render_deck
 from drumflow.dem.restitution import calibrate_restitution, realised_restitution
 from drumflow.dem.thermo import ThermoParser
-from drumflow.dem.timestep import MIN_STEPS_PER_CONTACT, hertz_contact_time, rayleigh_time
+from drumflow.dem.timestep import (
+    MIN_STEPS_PER_CONTACT,
+    hertz_contact_time,
+    rayleigh_time,
+)
 from drumflow.runner import Runner
 from drumflow.verify.checks import Check, relative_error
 
@@ -402,4 +406,123 @@ def contact_conduction_check(
         wall_time_s=time.perf_counter() - t0,
         details={"ratio": res.ratio, "q_heatflux_output_W": res.q_flux_output,
                  "time_step_s": res.time_step, "steps": res.steps},
+    )
+
+
+# ---------------------------------------------------------------------------------------------
+# Particle-wall collision
+# ---------------------------------------------------------------------------------------------
+
+#: One particle meets a flat wall (the drum's wall contact model, a primitive plane) head-on.
+#: Written here rather than as a template: it is only ever rendered by this check.
+_WALL_DECK = """\
+# One particle hitting a flat wall head-on, for drumflow's particle-wall restitution check.
+atom_style      granular
+atom_modify     map array
+boundary        f f f
+newton          off
+communicate     single vel yes
+units           si
+{soft}
+region          box block -0.02 0.02 -0.02 0.02 -0.01 0.05 units box
+create_box      2 box
+create_atoms    1 single 0 0 {z0:.12g} units box
+set             atom 1 diameter {diameter} density {density}
+fix m1 all property/global youngsModulus peratomtype {E:.9g} {E_wall:.9g}
+fix m2 all property/global poissonsRatio peratomtype {nu} {nu}
+fix m3 all property/global coefficientRestitution peratomtypepair 2 {e:.9g} {e:.9g} {e:.9g} {e:.9g}
+fix m4 all property/global coefficientFriction peratomtypepair 2 0.2 0.2 0.2 0.2
+fix m5 all property/global coefficientRollingFriction peratomtypepair 2 0.05 0.05 0.05 0.05
+pair_style      gran model hertz tangential history rolling_friction cdt
+pair_coeff      * *
+neighbor        {skin} bin
+neigh_modify    delay 0
+timestep        {dt:.9g}
+fix walls all wall/gran model hertz tangential history rolling_friction cdt primitive type 2 zplane 0.0
+fix integrate all nve/sphere
+velocity        all set 0 0 {v:.9g} units box
+variable vz1 equal vz[1]
+variable z1 equal z[1]
+thermo_style    custom step v_vz1 v_z1
+thermo          {steps}
+thermo_modify   norm no flush yes format float %.15g
+run             {steps}
+"""
+
+
+def run_wall_collision(
+    work: Path, runner: Runner, coefficient: float, youngs_modulus: float, wall_modulus: float,
+    speed: float, time_step: float, phase: float = 0.0,
+) -> float:
+    """Drop one sphere head-on onto a plane wall; return |v_z after| / |v_z before|."""
+    radius = 0.5 * DIAMETER
+    mass = DENSITY * math.pi / 6.0 * DIAMETER**3
+    e_eff = 1.0 / ((1 - POISSON**2) / youngs_modulus + (1 - POISSON**2) / wall_modulus)
+    t_h = hertz_contact_time_effective(mass, radius, e_eff, speed)
+    gap = (2.0 + phase) * speed * time_step
+    steps = math.ceil((gap / speed + 3.0 * t_h) / time_step)
+    work.mkdir(parents=True, exist_ok=True)
+    deck = _WALL_DECK.format(
+        soft="soft_particles  yes" if youngs_modulus < SOFT_PARTICLE_LIMIT else "",
+        z0=radius + gap, diameter=DIAMETER, density=DENSITY, E=youngs_modulus, E_wall=wall_modulus,
+        nu=POISSON, e=coefficient, skin=0.5 * DIAMETER, dt=time_step, v=-speed, steps=steps)
+    (work / "in.wall").write_text(deck)
+    command = runner.profile.mpi_command(["liggghts", "-in", "in.wall", "-log", "log.liggghts"], 1)
+    runner.run("liggghts", command, work, work / "liggghts.out", timeout=300)
+    parser = ThermoParser(columns=("step", "vz1", "z1"))
+    for line in (work / "log.liggghts").read_text(errors="replace").splitlines():
+        parser(line)
+    table = pd.DataFrame(parser.rows, columns=["step", "vz1", "z1"]).drop_duplicates("step", keep="last")
+    first, last = table.iloc[0], table.iloc[-1]
+    if float(last["z1"]) <= radius:
+        raise RuntimeError(f"{work}: the sphere still touches the wall after {steps} steps")
+    return float(last["vz1"]) / -float(first["vz1"])
+
+
+def hertz_contact_time_effective(m_eff: float, r_eff: float, e_eff: float, speed: float) -> float:
+    """Elastic Hertz contact time 2.87 (m*^2 / (R* E*^2 v))^(1/5), s (as for two spheres)."""
+    return 2.87 * (m_eff**2 / (r_eff * e_eff**2 * speed)) ** 0.2
+
+
+def wall_restitution_check(
+    work: Path, runner: Runner, restitution: float = 0.3, speed: float = IMPACT_SPEED,
+    correction: bool = True, phases: int = 8, tolerance: float = 0.02,
+) -> Check:
+    """A particle hits a plane wall head-on: realised against input restitution.
+
+    As a run of the tiny drum does it: drumflow's default time step for the case and the
+    particle-wall coefficient :func:`drumflow.dem.restitution.calibrate_case` gives LIGGGHTS
+    (made at the case's typical impact speed, 1.4 m/s); the collision runs at ``speed``
+    (2 m/s: off the correction's speed) at ``phases`` first-touch phases, whose mean is
+    compared with the case's particle-wall coefficient. ``correction=False`` passes the input
+    through, as ``run.restitution_correction = false`` does.
+    """
+    from drumflow.dem.restitution import calibrate_case
+    from drumflow.dem.timestep import choose_time_step
+    from drumflow.verify.scenes import tiny_drum
+
+    t0 = time.perf_counter()
+    case = tiny_drum(contacts__particle_wall={"friction": 0.2, "restitution": restitution,
+                                              "rolling_friction": 0.05},
+                     run__restitution_correction=correction)
+    plan = choose_time_step(case)
+    dt = float(plan.time_step)
+    calibration = calibrate_case(case, dt)["particle_wall"]
+    coefficient = calibration.liggghts_value
+    wall_modulus = case.contacts.wall_youngs_modulus or case.particles.youngs_modulus
+    realised = [run_wall_collision(work / f"phase{k}", runner, coefficient, case.particles.youngs_modulus,
+                                   wall_modulus, speed, dt, k / phases) for k in range(phases)]
+    mean = sum(realised) / phases
+    return Check(
+        name=f"wall_restitution_e{restitution:g}_v{speed:g}" + ("" if correction else "_uncorrected"),
+        measured=mean, expected=restitution, error=relative_error(mean, restitution),
+        tolerance=tolerance,
+        note=f"one 8 mm sphere (E = {case.particles.youngs_modulus:.3g} Pa) head-on onto a plane "
+             f"wall (E = {wall_modulus:.3g} Pa) at {speed:g} m/s, no gravity, mean of {phases} "
+             f"first-touch phases; the tiny drum's dt = {dt:.3g} s, "
+             f"{calibration.steps_per_contact:.1f} steps per contact; LIGGGHTS given {coefficient:.4g}",
+        reference="the case's input coefficient of restitution",
+        wall_time_s=time.perf_counter() - t0,
+        details={"time_step_s": dt, "liggghts_coefficient": coefficient, "realised_per_phase": realised,
+                 "calibration": calibration.as_dict()},
     )

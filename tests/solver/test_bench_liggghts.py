@@ -9,20 +9,19 @@ from __future__ import annotations
 
 import json
 import math
-import shutil
 from pathlib import Path
 
 import pandas as pd
 import pytest
+from conftest import LIGGGHTS, requires_solver, tiny_case_dict
 
-from conftest import tiny_case_dict
 from drumflow.bench import run_bench
 from drumflow.case import case_from_dict
 
 pytestmark = [
     pytest.mark.solver,
     pytest.mark.timeout(600),
-    pytest.mark.skipif(shutil.which("liggghts") is None, reason="LIGGGHTS not installed (scripts/install.sh)"),
+    requires_solver(*LIGGGHTS),
 ]
 
 

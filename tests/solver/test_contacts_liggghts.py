@@ -4,10 +4,10 @@ held contact against the paper's Eq. 24 (drumflow.verify.contacts). About 10 s i
 from __future__ import annotations
 
 import math
-import shutil
 from pathlib import Path
 
 import pytest
+from conftest import LIGGGHTS, requires_solver
 
 from drumflow.dem.conduction import GEOMETRIC_AREA_FACTOR
 from drumflow.runner import Runner
@@ -21,7 +21,7 @@ from drumflow.verify.contacts import (
 pytestmark = [
     pytest.mark.solver,
     pytest.mark.timeout(300),
-    pytest.mark.skipif(shutil.which("liggghts") is None, reason="LIGGGHTS not installed (scripts/install.sh)"),
+    requires_solver(*LIGGGHTS),
 ]
 
 

@@ -8,26 +8,29 @@ which converges in a few seconds on one core.
 from __future__ import annotations
 
 import copy
-import shutil
 import tomllib
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pytest
+from conftest import CASES, OPENFOAM, requires_solver
 
-from conftest import CASES
 from drumflow.air.field import AirField, plot_air_cross_section
 from drumflow.air.foam import AirNotConvergedError, AirSolution, solve_air
-from drumflow.air.verify_couette import verify_couette
 from drumflow.case import Case, case_from_dict
 from drumflow.runner import Runner
+from drumflow.verify.air_field import (
+    PROFILE_MAX_TOLERANCE,
+    PROFILE_RMS_TOLERANCE,
+    profile_difference,
+    sampled_profiles,
+)
+from drumflow.verify.couette import verify_couette
 
 pytestmark = [
     pytest.mark.solver,
-    pytest.mark.skipif(
-        shutil.which("simpleFoam") is None, reason="OpenFOAM (simpleFoam) not installed"
-    ),
+    requires_solver(*OPENFOAM),
 ]
 
 
@@ -108,7 +111,7 @@ def test_smoke_drum_air_field_grid(
     assert (tmp_path / "air.png").stat().st_size > 10_000
 
 
-@pytest.mark.timeout(120)
+@pytest.mark.timeout(240)
 def test_two_ranks_give_the_same_flow(
     smoke_air: tuple[Case, AirSolution, Runner], tmp_path: Path
 ) -> None:
@@ -117,7 +120,19 @@ def test_two_ranks_give_the_same_flow(
     assert sol.converged
     assert not list(sol.case_dir.glob("processor*"))
     assert abs(sol.mass_flow_imbalance) < 0.005
-    assert sol.mean_axial_velocity == pytest.approx(serial.mean_axial_velocity, rel=0.005)
+    # Bulk numbers agree for any two mass-conserving fields; the flow itself is compared on
+    # radial lines of three cross-sections (axial velocity and swirl, ~800 points), within the
+    # iteration error the residual target leaves (tolerances argued in drumflow.verify.air_field).
+    one_rank = sampled_profiles(AirField.from_solution(serial, case), case)
+    diff = profile_difference(one_rank, sampled_profiles(AirField.from_solution(sol, case), case))
+    assert diff["velocity_rms"] < PROFILE_RMS_TOLERANCE, diff
+    assert diff["velocity_max"] < PROFILE_MAX_TOLERANCE, diff
+    assert diff["swirl_rms"] < PROFILE_RMS_TOLERANCE, diff
+    # Measured: 3e-7 RMS and 4e-6 largest (of 3.07 m/s), far inside the tolerances. What the
+    # old bulk comparison missed: plug flow at the same mean axial velocity (no swirl, no
+    # wakes) passes it, and fails both profile tolerances (measured 2.6% RMS, 13% largest).
+    plug = profile_difference(one_rank, sampled_profiles(AirField.uniform(case), case))
+    assert plug["velocity_rms"] > PROFILE_RMS_TOLERANCE and plug["velocity_max"] > PROFILE_MAX_TOLERANCE
 
 
 @pytest.mark.timeout(120)

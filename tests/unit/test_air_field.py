@@ -21,9 +21,11 @@ from drumflow.air.field import (
     rotate_to_drum_frame,
     rotate_to_lab_frame,
 )
-from drumflow.air.foam import AirNotConvergedError, inlet_turbulence, parse_residual_log
+from drumflow.air.foam_case import inlet_turbulence
+from drumflow.air.foam_results import parse_residual_log
 from drumflow.air.mesh import parse_check_mesh
 from drumflow.case import Case, case_from_dict
+from drumflow.errors import AirNotConvergedError
 from drumflow.geometry.lifters import lifter_area
 
 

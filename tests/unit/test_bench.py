@@ -9,9 +9,16 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from drumflow.bench import TOLERANCES, _add_errors
-from drumflow.bench.ladder import CONSERVATIVE, REFERENCE, apply_rung, ladder, relative_error, select
+from drumflow.bench.ladder import (
+    CONSERVATIVE,
+    REFERENCE,
+    apply_rung,
+    ladder,
+    relative_error,
+    select,
+)
 from drumflow.bench.pareto import pareto_front, plot_pareto
+from drumflow.bench.stage import TOLERANCES, _add_errors
 from drumflow.case import load_case
 from drumflow.dem.timestep import choose_time_step, rayleigh_time
 

@@ -177,3 +177,16 @@ def test_numeric_or_auto_fields_reject_nonpositive(smoke_dict: dict) -> None:
     assert any(p.startswith("air.mesh_size = -1:") and "> 0" in p and "'auto'" in p for p in problems)
     assert any(p.startswith("run.time_step = -1e-05:") for p in problems)
     assert any(p.startswith("air.coupling_interval = 0:") and ">= 1" in p for p in problems)
+
+
+@pytest.mark.parametrize("size", [1e300, 0.41])
+def test_air_mesh_size_larger_than_the_drum_is_refused(smoke_dict: dict, size: float) -> None:
+    # Regression: `check` accepted air.mesh_size = 1e300 (the smoke drum is 0.4 m across).
+    smoke_dict["air"]["mesh_size"] = size
+    with pytest.raises(CaseError, match=r"air\.mesh_size = .* must be at most the drum diameter \(0\.4 m\)"):
+        case_from_dict(smoke_dict)
+
+
+def test_air_mesh_size_up_to_the_drum_is_accepted(smoke_dict: dict) -> None:
+    smoke_dict["air"]["mesh_size"] = 0.4
+    assert case_from_dict(smoke_dict).air.mesh_size == 0.4

@@ -8,7 +8,11 @@ import math
 import pytest
 
 from drumflow.dem.conduction import GEOMETRIC_AREA_FACTOR, liggghts_conductivity
-from drumflow.dem.timestep import MIN_STEPS_PER_CONTACT, hertz_contact_time, rayleigh_time
+from drumflow.dem.timestep import (
+    MIN_STEPS_PER_CONTACT,
+    hertz_contact_time,
+    rayleigh_time,
+)
 from drumflow.verify.contacts import (
     decay_conductance,
     default_time_step,

@@ -9,13 +9,13 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from drumflow.analysis._validate import AnalysisInputError
 from drumflow.analysis.correlation import (
     CorrelationRangeWarning,
     anova_table,
     fit_nusselt_correlation,
     fit_nusselt_correlation_from_runs,
 )
+from drumflow.errors import AnalysisInputError
 
 # Paper, Eq. 58 and Table 8.
 A, B, C = 0.0531283, 0.523707, 1.00824

@@ -87,25 +87,49 @@ def test_uniform_field_ignores_rotation() -> None:
     assert np.allclose(air_velocity_at(field, x, 1.3, 0.5), [0.0, 0.0, -3.0])
 
 
-class _SwirlField:
-    """A field that turns with the drum: u = (-y, x, 0) in the drum frame (solid rotation)."""
+class _DrumFixedField:
+    """A field fixed to the drum and not symmetric about its axis: in drum-frame coordinates
+    u = (1, 0, x) (a cross-flow along the drum's own x axis, and an axial velocity growing
+    with drum-frame x)."""
 
     def sample(self, points: np.ndarray) -> np.ndarray:
-        return np.column_stack([-points[:, 1], points[:, 0], np.zeros(len(points))])
+        return np.column_stack([np.ones(len(points)), np.zeros(len(points)), points[:, 0]])
 
 
-def test_rotating_field_is_sampled_in_the_drum_frame() -> None:
-    # Solid-body rotation looks the same in every frame orientation: the lab value at a lab
-    # point must equal (-y, x, 0) of that lab point, whatever the drum's angle.
-    x = np.array([[0.3, 0.1, 0.0], [-0.2, 0.4, 1.0]])
-    u = air_velocity_at(_SwirlField(), x, time_s=2.0, omega=0.9)
-    assert np.allclose(u, np.column_stack([-x[:, 1], x[:, 0], np.zeros(2)]))
+@pytest.mark.parametrize(("turn", "expected"), [
+    # Fraction of a turn at the sampling time, and by hand the lab velocity at the lab point
+    # (0.3, 0.1, 0). The drum turns counter-clockwise about +z, so after a quarter turn the
+    # drum's +x axis points along lab +y, and the lab point sits at drum-frame (0.1, -0.3).
+    (0.0, (1.0, 0.0, 0.3)),
+    (0.25, (0.0, 1.0, 0.1)),
+    (0.5, (-1.0, 0.0, -0.3)),
+    (0.75, (0.0, -1.0, -0.1)),
+])
+def test_rotating_field_is_sampled_at_the_drum_angle(
+    turn: float, expected: tuple[float, float, float],
+) -> None:
+    omega = 2.0 * math.pi * 0.5  # 30 rpm, the tiny drum's
+    t = turn / 0.5  # the time at which the drum has made ``turn`` of a revolution
+    u = air_velocity_at(_DrumFixedField(), np.array([[0.3, 0.1, 0.0]]), time_s=t, omega=omega)
+    assert u[0] == pytest.approx(expected, abs=1e-12)
+
+
+def test_sampling_angle_off_by_one_coupling_step_is_seen() -> None:
+    """An angle late by one coupling interval (10 steps of 5e-5 s at 30 rpm: 0.18 degrees)
+    moves the sampled axial velocity at the lab point (0.1, 0, 0) by 1e-4 m/s in 0.1: well
+    above round-off, so the frame test above pins the angle, not just the direction."""
+    omega, dt = math.pi, 5e-5
+    x = np.array([[0.1, 0.0, 0.0]])
+    on_time = air_velocity_at(_DrumFixedField(), x, time_s=0.25, omega=omega)
+    late = air_velocity_at(_DrumFixedField(), x, time_s=0.25 - 10 * dt, omega=omega)
+    assert abs(on_time[0, 2] - late[0, 2]) > 1e-5
 
 
 def test_coupling_log_sums_ranks_and_supersedes_attempts(tmp_path: Path) -> None:
     head = "step,time_s,steps,heat_to_particles_W,drag_x_N,drag_y_N,drag_z_N,particles,mean_slip_m_s\n"
-    (tmp_path / "rank0.0.csv").write_text(head + "0,0,10,-1,0,0,0,5,1\n10,0.1,10,-1,0,0,0,5,1\n20,0.2,10,-1,0,0,0,5,1\n")
-    (tmp_path / "rank1.0.csv").write_text(head + "0,0,10,-2,0,0,0,5,1\n10,0.1,10,-2,0,0,0,5,1\n20,0.2,10,-2,0,0,0,5,1\n")
+    for rank, q in ((0, -1), (1, -2)):
+        rows = "".join(f"{s},{s / 100:g},10,{q},0,0,0,5,1\n" for s in (0, 10, 20))
+        (tmp_path / f"rank{rank}.0.csv").write_text(head + rows)
     (tmp_path / "rank0.20.csv").write_text(head + "20,0.2,10,-4,0,0,0,10,1\n")
     table = read_coupling(tmp_path, time_step=0.01)
     assert table["step"].tolist() == [0, 10, 20]

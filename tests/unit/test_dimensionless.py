@@ -7,7 +7,6 @@ import math
 import numpy as np
 import pytest
 
-from drumflow.analysis._validate import AnalysisInputError
 from drumflow.analysis.dimensionless import (
     dimensionless_numbers,
     drum_volume,
@@ -15,6 +14,7 @@ from drumflow.analysis.dimensionless import (
     particle_volume,
     void_fraction,
 )
+from drumflow.errors import AnalysisInputError
 
 T_300K = 300.0 - 273.15  # a node of the air table: properties known exactly
 T_325K = 325.0 - 273.15

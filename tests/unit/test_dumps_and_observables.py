@@ -26,7 +26,7 @@ ITEM: BOX BOUNDS ff ff ff
 -0.2 0.2
 -0.2 0.2
 0 0.1
-ITEM: ATOMS id x y z vx vy vz radius f_Temp[0] 
+ITEM: ATOMS id x y z vx vy vz radius f_Temp[0]
 {rows}"""
 
 
@@ -36,7 +36,8 @@ def _write(folder: Path, step: int, rows: list[tuple], prefix: str = "snap") -> 
 
 
 def test_read_hand_written_dump(tmp_path: Path) -> None:
-    _write(tmp_path, 100, [(2, 0.1, 0.2, 0.3, 0, 0, -1, 0.004, 80.5), (1, -0.1, 0.0, 0.05, 0, 0, 0, 0.004, 90.0)])
+    _write(tmp_path, 100, [(2, 0.1, 0.2, 0.3, 0, 0, -1, 0.004, 80.5),
+                           (1, -0.1, 0.0, 0.05, 0, 0, 0, 0.004, 90.0)])
     snap = read_dump(tmp_path / "snap.0000000100.txt")
     assert snap.step == 100
     assert snap.ids.tolist() == [1, 2]  # sorted by id

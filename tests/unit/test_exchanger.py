@@ -20,7 +20,6 @@ import math
 
 import pytest
 
-from drumflow.analysis._validate import AnalysisInputError
 from drumflow.analysis.exchanger import (
     ExchangerResult,
     InfeasibleExchangerError,
@@ -30,6 +29,7 @@ from drumflow.analysis.exchanger import (
     solve_outlet_temperature,
 )
 from drumflow.analysis.heat_transfer import falling_particle_area
+from drumflow.errors import AnalysisInputError
 
 PLANT = dict(
     material_mass_flow_kg_s=13.88889,

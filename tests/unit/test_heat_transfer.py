@@ -7,13 +7,13 @@ import math
 import numpy as np
 import pytest
 
-from drumflow.analysis._validate import AnalysisInputError
 from drumflow.analysis.heat_transfer import (
     falling_particle_area,
     log_mean_temperature_difference,
     particle_mass,
     per_step_heat_transfer,
 )
+from drumflow.errors import AnalysisInputError
 
 NDArrayLike = float | np.ndarray
 

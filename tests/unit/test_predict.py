@@ -5,13 +5,14 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
+from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
-from test_methodology import AIR_FLOW, synthetic_case_dict, write_synthetic_run
+from support.synthetic_run import AIR_FLOW
 
-from drumflow.analysis._validate import AnalysisInputError
 from drumflow.analysis.correlation import (
     CorrelationRangeWarning,
     NusseltCorrelation,
@@ -20,10 +21,14 @@ from drumflow.analysis.correlation import (
 from drumflow.analysis.exchanger import solve_outlet_temperature
 from drumflow.analysis.methodology import MethodologyResult, analyse_run, plant_streams
 from drumflow.analysis.predict import ASSUMPTIONS, PAPER_REYNOLDS_RANGE, predict_plant
+from drumflow.errors import AnalysisInputError
 
 
 @pytest.fixture(scope="module")
-def reference(tmp_path_factory: pytest.TempPathFactory) -> MethodologyResult:
+def reference(
+    tmp_path_factory: pytest.TempPathFactory,
+    write_synthetic_run: Callable[..., Any],
+) -> MethodologyResult:
     root = write_synthetic_run(tmp_path_factory.mktemp("pred") / "run", extras=False)
     return analyse_run(root, nusselt_conductivity="particle")
 
@@ -165,7 +170,11 @@ def test_errors(reference: MethodologyResult) -> None:
         predict_plant(50.0, case, reference=reference, air_mass_flow=0.0)
 
 
-def test_reference_of_another_case_is_flagged(reference: MethodologyResult, tmp_path: Path) -> None:
+def test_reference_of_another_case_is_flagged(
+    reference: MethodologyResult,
+    tmp_path: Path,
+    synthetic_case_dict: Callable[..., Any],
+) -> None:
     from drumflow.case import case_from_dict
 
     other = case_from_dict(synthetic_case_dict(drum={"rpm": 12.0}))

@@ -4,22 +4,27 @@ from __future__ import annotations
 
 import base64
 import re
+from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
-from test_methodology import AIR_FLOW, H_TRUE, synthetic_case_dict, write_synthetic_run
+from support.synthetic_run import AIR_FLOW, H_TRUE
 
-from drumflow.errors import RunDirectoryError
+from drumflow.errors import RenderError, RunDirectoryError
 from drumflow.report.html import write_report
-from drumflow.report.render import RenderError, render_particles, render_particles_isolated
+from drumflow.report.render import render_particles, render_particles_isolated
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 SRC_RE = re.compile(r'src="([^"]*)"')
 
 
 @pytest.fixture(scope="module")
-def single(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, str]:
+def single(
+    tmp_path_factory: pytest.TempPathFactory,
+    write_synthetic_run: Callable[..., Any],
+) -> tuple[Path, str]:
     """A one-run report with the 3-D render (rendered once for the module: ~5 s)."""
     tmp = tmp_path_factory.mktemp("report")
     run = write_synthetic_run(tmp / "run")
@@ -64,7 +69,11 @@ def test_single_run_explains_missing_table8(single: tuple[Path, str]) -> None:
     assert "A single run cannot identify the exponent b" in html
 
 
-def test_sweep_has_anova_and_comparison(tmp_path: Path) -> None:
+def test_sweep_has_anova_and_comparison(
+    tmp_path: Path,
+    write_synthetic_run: Callable[..., Any],
+    synthetic_case_dict: Callable[..., Any],
+) -> None:
     r1 = write_synthetic_run(tmp_path / "a")
     d2 = synthetic_case_dict(air={"mass_flow": 2 * AIR_FLOW})
     d2["name"] = "smoke_air50"
@@ -77,7 +86,11 @@ def test_sweep_has_anova_and_comparison(tmp_path: Path) -> None:
     assert "3-D rendering was switched off" in html
 
 
-def test_run_without_air_still_renders(tmp_path: Path) -> None:
+def test_run_without_air_still_renders(
+    tmp_path: Path,
+    write_synthetic_run: Callable[..., Any],
+    synthetic_case_dict: Callable[..., Any],
+) -> None:
     d = synthetic_case_dict(air={"model": "none"})
     root = write_synthetic_run(tmp_path / "r", case_dict=d, constant_temperature=True)
     html = write_report([root], tmp_path / "noair.html", render_3d=False).read_text()
@@ -89,7 +102,11 @@ def test_run_without_air_still_renders(tmp_path: Path) -> None:
     assert len(SRC_RE.findall(html)) >= 2
 
 
-def test_render_failure_becomes_a_note(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+def test_render_failure_becomes_a_note(
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    write_synthetic_run: Callable[..., Any],
+) -> None:
     import drumflow.report.render as render
 
     def broken(*args: object, **kwargs: object) -> Path:
@@ -101,7 +118,7 @@ def test_render_failure_becomes_a_note(tmp_path: Path, monkeypatch: pytest.Monke
     assert "the 3-D picture could not be rendered: no OpenGL here" in html
 
 
-def test_missing_pictures_are_notes(tmp_path: Path) -> None:
+def test_missing_pictures_are_notes(tmp_path: Path, write_synthetic_run: Callable[..., Any]) -> None:
     root = write_synthetic_run(tmp_path / "r")
     (root / "post" / "crossings.png").unlink()
     (root / "post" / "mean_temperature.png").unlink()
@@ -111,7 +128,11 @@ def test_missing_pictures_are_notes(tmp_path: Path) -> None:
     assert "no mean_temperature.png in the run" in html
 
 
-def test_case_text_is_escaped(tmp_path: Path) -> None:
+def test_case_text_is_escaped(
+    tmp_path: Path,
+    write_synthetic_run: Callable[..., Any],
+    synthetic_case_dict: Callable[..., Any],
+) -> None:
     d = synthetic_case_dict()
     d["description"] = "<script>alert(1)</script> & more"
     root = write_synthetic_run(tmp_path / "r", case_dict=d)

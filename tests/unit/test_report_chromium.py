@@ -12,20 +12,24 @@ import re
 import shutil
 import struct
 import subprocess
+from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
-from test_methodology import write_synthetic_run
 
 from drumflow.report.html import write_report
 
 CHROMIUM = shutil.which("chromium")
 
-pytestmark = pytest.mark.skipif(
-    CHROMIUM is None,
-    reason="chromium is not installed (apt-get install -y chromium); the browser check needs it",
-)
+pytestmark = [
+    pytest.mark.chromium,
+    pytest.mark.skipif(
+        CHROMIUM is None,
+        reason="chromium is not installed (apt-get install -y chromium); the browser check needs it",
+    ),
+]
 
 
 def screenshot(html: Path, png: Path, profile: Path, size: tuple[int, int] = (1200, 2000)) -> None:
@@ -55,7 +59,7 @@ def _solid_red_like(match: re.Match[str]) -> str:
     return 'src="data:image/png;base64,' + base64.b64encode(buf.getvalue()).decode() + '"'
 
 
-def test_report_renders_in_chromium(tmp_path: Path) -> None:
+def test_report_renders_in_chromium(tmp_path: Path, write_synthetic_run: Callable[..., Any]) -> None:
     import matplotlib.image as mpimg
 
     run = write_synthetic_run(tmp_path / "run")

@@ -62,7 +62,8 @@ def test_profile_mpi_command_and_root_env() -> None:
 
 
 def test_last_error_line() -> None:
-    assert last_error_line(["ok", "ERROR: a", "fine", "assertion failed (x.h:1)"]) == "assertion failed (x.h:1)"
+    lines = ["ok", "ERROR: a", "fine", "assertion failed (x.h:1)"]
+    assert last_error_line(lines) == "assertion failed (x.h:1)"
     assert last_error_line(["ok"]) is None
 
 

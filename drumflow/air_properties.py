@@ -28,12 +28,16 @@ T      rho       c_p          mu * 1e7      nu * 1e6      k * 1e3       Pr
 
 Temperatures in this package are in degrees Celsius; they are converted with
 ``T[K] = T[deg C] + 273.15``. Outside 200-600 K (-73.15 to 326.85 deg C) the functions raise
-:class:`~drumflow.analysis._validate.AnalysisInputError` instead of extrapolating.
+:class:`~drumflow.errors.AnalysisInputError` instead of extrapolating.
 
 Note that the paper's own Figure 9 quotes ``Pr = 0.7282`` at the 30 deg C air inlet, which is the
 value of Cengel's air table (Table A-15, 30 deg C) rather than Incropera's (0.7066 at 303.15 K
 here); the two tables differ by about 3 % in Pr, which matters only when comparing absolute
 values with the paper, not for the method.
+
+The solvers (OpenFOAM's incompressible air, the DEM drag) use the ideal-gas density at the case's
+inlet temperature and pressure instead of the 1 atm table column; :func:`ideal_gas_density` is the
+one place it is computed.
 """
 
 from __future__ import annotations
@@ -44,10 +48,11 @@ from typing import Final
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from drumflow.analysis._validate import AnalysisInputError
+from drumflow.errors import AnalysisInputError
 
 __all__ = [
     "KELVIN_OFFSET",
+    "R_AIR",
     "TABLE",
     "TABLE_T_C",
     "TABLE_T_K",
@@ -57,6 +62,7 @@ __all__ = [
     "air_properties",
     "density",
     "dynamic_viscosity",
+    "ideal_gas_density",
     "kinematic_viscosity",
     "prandtl",
     "specific_heat",
@@ -65,6 +71,9 @@ __all__ = [
 
 KELVIN_OFFSET: Final = 273.15
 """Offset between kelvin and degrees Celsius."""
+
+R_AIR: Final = 287.05
+"""Specific gas constant of dry air (J/(kg K))."""
 
 # Table columns in SI units. The tuples are the source of truth; the read-only arrays below are
 # built from them so a caller cannot modify the table through a returned view.
@@ -321,3 +330,24 @@ def air_properties(temperature_c: float, *, name: str = "temperature_c") -> AirP
         raise AnalysisInputError(name, f"array of shape {t.shape}", "a scalar temperature")
     props = {col: float(_interp(col, t, name)) for col in TABLE}
     return AirProperties(temperature_c=float(t), **props)
+
+
+def ideal_gas_density(temperature_c: float, pressure_kpa: float = 101.325) -> float:
+    """Ideal-gas density of dry air, rho = p / (R_air T) (kg/m3).
+
+    The air in the drum is treated as incompressible at this density (the paper: "constant
+    density gas"), evaluated at the inlet temperature and pressure of the case.
+
+    Parameters
+    ----------
+    temperature_c
+        Air temperature (deg C).
+    pressure_kpa
+        Absolute pressure (kPa).
+
+    Returns
+    -------
+    float
+        rho (kg/m3).
+    """
+    return pressure_kpa * 1e3 / (R_AIR * (temperature_c + KELVIN_OFFSET))

@@ -2,8 +2,10 @@
 
 Every shortcut drumflow takes (or the case asks for) is recorded in the run's manifest under
 ``skips``: what is skipped, the speed-up and the errors against the finest setting as
-measured on the reference scene (``measured_smoke.json``, written from ``drumflow bench
-cases/smoke.toml`` on the machine named in it). The numbers are the smoke scene's; on another
+measured on the reference scene (``drumflow/data/measured_smoke.json``, package data written
+by ``scripts/ship_bench.py`` from ``drumflow bench cases/smoke.toml`` on the machine named in
+it). The pipeline records them; this module sits low (it imports no stage) so that any stage or
+the bench can use it. The numbers are the smoke scene's; on another
 scene they are a guide, and ``drumflow bench`` on that scene measures its own.
 """
 
@@ -11,19 +13,20 @@ from __future__ import annotations
 
 import json
 from functools import lru_cache
-from pathlib import Path
+from importlib import resources
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
     from drumflow.case import Case
 
-MEASURED = Path(__file__).with_name("measured_smoke.json")
+#: The shipped bench results, as package data (found in a wheel as well as in a checkout).
+MEASURED = resources.files("drumflow") / "data" / "measured_smoke.json"
 
 
 @lru_cache(maxsize=1)
 def measured() -> dict[str, Any]:
     """The shipped bench results: ``{"source": ..., "rows": {rung: {...}}}`` ({} if absent)."""
-    if not MEASURED.exists():
+    if not MEASURED.is_file():
         return {}
     data = json.loads(MEASURED.read_text())
     return data if isinstance(data, dict) else {}
@@ -47,8 +50,23 @@ def _pair(with_skip: str, without: str) -> dict[str, Any]:
     }
 
 
-def skips(case: Case, time_step_mode: str, coupled: bool, wall_motion: str) -> list[dict[str, Any]]:
-    """The shortcuts this run takes, each with its measured speed-up and error."""
+def skips(case: Case, time_step_mode: str, coupled: bool, wall_motion: str,
+          processes: int) -> list[dict[str, Any]]:
+    """The shortcuts this run takes, each with its measured speed-up and error.
+
+    Parameters
+    ----------
+    case
+        The case.
+    time_step_mode
+        How the time step was chosen (:attr:`drumflow.dem.timestep.TimeStepChoice.mode`).
+    coupled
+        The air acts on the particles.
+    wall_motion
+        ``"static_shell"`` or ``"moving_mesh"`` (the geometry stage's choice).
+    processes
+        MPI processes of the run.
+    """
     out: list[dict[str, Any]] = []
 
     def add(skip: str, applies: bool, with_skip: str, without: str) -> None:
@@ -62,7 +80,7 @@ def skips(case: Case, time_step_mode: str, coupled: bool, wall_motion: str) -> l
     add("air updated every 'auto' steps (0.2% of the particles' thermal time constant) instead "
         "of every 10 steps", coupled and case.air.coupling_interval == "auto", "default", "coupling_10")
     add("serial run (few particles per process) instead of 2 MPI processes",
-        case.process_count == 1, "default", "mpi_2")
+        processes == 1, "default", "mpi_2")
     add("no particle-particle conduction", not case.run.conduction, "no_conduction", "default")
     add("uniform plug-flow air instead of the CFD air field", case.air.model == "uniform",
         "uniform_air", "default")

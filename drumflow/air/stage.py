@@ -1,0 +1,166 @@
+"""Air stage: the air field in the drum (one-way: the particles do not change it).
+
+Entry point :func:`run` (``run(case, rundir, runner, inputs) -> AirResult | None``). The stage
+returns only the field; how it acts on the particles (the coupling spec and its update
+interval) is built by the pipeline with :func:`drumflow.coupling.spec.build_coupling`.
+
+``air.model``:
+
+* ``"none"``: no air; particles exchange heat only by conduction.
+* ``"uniform"``: plug flow at the mean axial velocity mdot / (rho A_free), no CFD at all
+  (quick studies and tests).
+* ``"cfd"``: a steady OpenFOAM field (:mod:`drumflow.air.foam`), cached by a hash of
+  everything it depends on, so a second run with the same drum and air settings does not run
+  OpenFOAM.
+
+The air flows counter-current, from the outlet end (z = l) towards the feed end (z = 0), at
+the case's inlet temperature throughout (one-way coupling: the particles do not heat it).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import time
+from collections.abc import Callable
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from drumflow.air.source import FieldSource, mean_axial_velocity, uniform_field
+from drumflow.air_properties import ideal_gas_density
+from drumflow.geometry.lifters import free_area
+
+if TYPE_CHECKING:
+    from drumflow.case import Case
+    from drumflow.rundir import RunDir
+    from drumflow.runner import Runner
+
+__all__ = ["AirInputs", "AirResult", "AirSummary", "air_cache_dir", "free_area", "run"]
+
+
+def air_cache_dir() -> Path:
+    """Where solved air fields are kept across runs (``DRUMFLOW_CACHE`` overrides it)."""
+    root = os.environ.get("DRUMFLOW_CACHE") or os.path.join(
+        os.environ.get("XDG_CACHE_HOME", os.path.expanduser("~/.cache")), "drumflow"
+    )
+    return Path(root) / "air"
+
+
+@dataclass
+class AirSummary:
+    """What the run's summary reports about the air.
+
+    ``coupling_interval_steps`` is filled in by the pipeline when it builds the coupling spec.
+    """
+
+    model: str
+    density_kg_m3: float
+    mean_axial_velocity_m_s: float
+    mass_flow_in_kg_s: float
+    mass_flow_out_kg_s: float
+    coupling_interval_steps: int = 0
+    cache_hit: bool = False
+    solve_wall_time_s: float = 0.0
+    extra: dict[str, Any] = field(default_factory=dict)
+
+    def as_dict(self) -> dict[str, Any]:
+        return asdict(self)
+
+
+@dataclass(frozen=True)
+class AirInputs:
+    """What the air stage needs besides the case.
+
+    Attributes
+    ----------
+    processes
+        MPI ranks for simpleFoam (from the launch profile).
+    progress
+        ``progress(stage, done, total)``: SIMPLE iterations of the ``"air"`` stage.
+    """
+
+    processes: int = 1
+    progress: Callable[[str, float, float], None] | None = None
+
+
+@dataclass(frozen=True)
+class AirResult:
+    """The air field (as the coupling loop loads it) and what the summary reports."""
+
+    source: FieldSource
+    summary: AirSummary
+
+
+def run(case: Case, rundir: RunDir, runner: Runner, inputs: AirInputs) -> AirResult | None:
+    """The air stage: the field for ``air.model`` (``None`` for ``"none"``).
+
+    ``"uniform"`` is plug flow at the mean axial velocity; ``"cfd"`` solves (or takes from the
+    cache) the OpenFOAM field.
+    """
+    if case.air.model == "none":
+        return None
+    if case.air.model == "uniform":
+        u_mean = mean_axial_velocity(case)
+        rho = ideal_gas_density(case.air.inlet_temperature_C, case.air.pressure_kPa)
+        summary = AirSummary("uniform", rho, u_mean, case.air.mass_flow, case.air.mass_flow)
+        result = AirResult(uniform_field(case), summary)
+    else:
+        result = _run_cfd(case, rundir, runner, inputs)
+    if inputs.progress:
+        # One bar per stage, finished when the stage ends (a converged solve stops before
+        # air.max_iterations).
+        inputs.progress("air", 1.0, 1.0)
+    return result
+
+
+def _solve_into_cache(case: Case, rundir: RunDir, runner: Runner, inputs: AirInputs,
+                      cache: Path) -> None:
+    from drumflow.air.field import AirField
+    from drumflow.air.foam import solve_air
+
+    work = rundir.air_openfoam
+    if work.exists():
+        shutil.rmtree(work)
+    total = float(case.air.max_iterations)
+    progress = inputs.progress
+
+    def on_iteration(iteration: int, *_: object) -> None:
+        if progress:
+            progress("air", min(float(iteration), total), total)
+
+    solution = solve_air(case, work, runner, processes=inputs.processes, on_iteration=on_iteration)
+    field_ = AirField.from_solution(solution, case)
+    cache.mkdir(parents=True, exist_ok=True)
+    field_.to_npz(cache / "field.npz")
+    (cache / "solution.json").write_text(json.dumps(solution.summary(), indent=2, default=str))
+
+
+def _run_cfd(case: Case, rundir: RunDir, runner: Runner, inputs: AirInputs) -> AirResult:
+    from drumflow.air.field import AirField, air_cache_key, plot_air_cross_section
+
+    key = air_cache_key(case)
+    cache = air_cache_dir() / key
+    hit = (cache / "field.npz").exists() and (cache / "solution.json").exists()
+    t0 = time.perf_counter()
+    if not hit:
+        _solve_into_cache(case, rundir, runner, inputs, cache)
+    info = json.loads((cache / "solution.json").read_text())
+    rundir.air.mkdir(parents=True, exist_ok=True)
+    shutil.copyfile(cache / "field.npz", rundir.air_field)
+    rundir.air_solution.write_text(json.dumps(info, indent=2))
+    plot_air_cross_section(AirField.from_npz(rundir.air_field), case, rundir.air_picture)
+    source = FieldSource({"kind": "grid", "path": str(rundir.air_field)}, key, case.drum.omega)
+    summary = AirSummary(
+        "cfd",
+        ideal_gas_density(case.air.inlet_temperature_C, case.air.pressure_kPa),
+        float(info.get("mean_axial_velocity_m_s", float("nan"))),
+        float(info.get("mass_flow_in_kg_s", float("nan"))),
+        float(info.get("mass_flow_out_kg_s", float("nan"))),
+        cache_hit=hit,
+        solve_wall_time_s=time.perf_counter() - t0,
+        extra={k: v for k, v in info.items()
+               if k in ("iterations", "final_residuals", "cells", "wall_time_s")},
+    )
+    return AirResult(source, summary)

@@ -1,0 +1,131 @@
+"""The coupling spec: how the air acts on the particles during the DEM run (one-way).
+
+This module is the one owner of the coupling between the air and the DEM stages. The air
+stage returns only its field (:class:`~drumflow.air.source.FieldSource`); the pipeline builds the spec with
+:func:`build_coupling` (which also chooses the update interval); the DEM stage receives it and
+writes the coupling loop's input file with :meth:`CouplingSpec.write_driver_file`, whose keys
+:mod:`drumflow.coupling.driver` reads. Neither stage imports the other.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from drumflow.air.source import FieldSource, mean_axial_velocity
+from drumflow.coupling.physics import AirState, auto_coupling_interval
+
+if TYPE_CHECKING:
+    from drumflow.case import Case
+    from drumflow.runner import LaunchProfile
+
+__all__ = ["COUPLING_FILE", "CouplingSpec", "FieldSource", "build_coupling", "driver_command"]
+
+#: The coupling loop's input file, in the DEM working directory.
+COUPLING_FILE = "coupling.json"
+#: Where each rank of the loop writes its log, relative to the DEM working directory.
+COUPLING_LOG_PATTERN = "coupling/rank{rank}.{start}.csv"
+#: Standard gravity, m/s^2 (the slip bound of the 'auto' interval).
+GRAVITY = 9.81
+
+
+@dataclass(frozen=True)
+class CouplingSpec:
+    """How the air acts on the particles during the DEM run (one-way).
+
+    Attributes
+    ----------
+    field
+        The driver's field spec (:attr:`FieldSource.field`).
+    field_key
+        Identifies the field (its hash), for the stage key.
+    interval
+        DEM steps between air updates.
+    temperature_C, pressure_kPa
+        The air's state (one-way: the air keeps its inlet temperature).
+    omega
+        Rotation rate of the frame the field was solved in (0 for a uniform field), rad/s.
+    """
+
+    field: dict[str, Any]
+    field_key: str
+    interval: int
+    temperature_C: float
+    pressure_kPa: float
+    omega: float
+
+    @property
+    def key(self) -> str:
+        """What the DEM stage's result depends on from the coupling."""
+        return f":air={self.field_key}:every={self.interval}"
+
+    def driver_file(self, deck: str, log: str, total_steps: int, time_step: float,
+                    tail: list[str]) -> dict[str, Any]:
+        """The coupling loop's input (:func:`drumflow.coupling.driver.run` reads these keys).
+
+        Parameters
+        ----------
+        deck, log
+            The LIGGGHTS deck and LIGGGHTS' own log, relative to the DEM working directory.
+        total_steps
+            The step the run ends at.
+        time_step
+            DEM time step, s.
+        tail
+            LIGGGHTS commands run after the loop (final restart, end of dumps).
+        """
+        return {
+            "deck": deck,
+            "log": log,
+            "total_steps": total_steps,
+            "interval": self.interval,
+            "time_step": time_step,
+            "omega": self.omega,
+            "air_temperature_C": self.temperature_C,
+            "air_pressure_kPa": self.pressure_kPa,
+            "field": self.field,
+            "coupling_log": COUPLING_LOG_PATTERN,
+            "tail": tail,
+        }
+
+    def write_driver_file(self, work: Path, deck: str, log: str, total_steps: int,
+                          time_step: float, tail: list[str]) -> Path:
+        """Write :meth:`driver_file` to ``work / COUPLING_FILE`` and return its path."""
+        path = work / COUPLING_FILE
+        path.write_text(json.dumps(self.driver_file(deck, log, total_steps, time_step, tail),
+                                   indent=2))
+        return path
+
+
+def coupling_interval(case: Case, time_step: float, dump_every: int) -> int:
+    """DEM steps between air updates: the case's, or 'auto' (see
+    :func:`~drumflow.coupling.physics.auto_coupling_interval`), at most one output interval."""
+    if case.air.coupling_interval != "auto":
+        return int(case.air.coupling_interval)
+    state = AirState.at(case.air.inlet_temperature_C, case.air.pressure_kPa)
+    # Largest slip: the air speed plus a particle falling across the whole drum.
+    max_slip = mean_axial_velocity(case) + math.sqrt(2 * GRAVITY * case.drum.diameter)
+    return auto_coupling_interval(
+        time_step, case.particles.diameter, case.particles.density,
+        case.particles.heat_capacity, state, max_slip, cap=dump_every,
+    )
+
+
+def build_coupling(case: Case, source: FieldSource, time_step: float, dump_every: int) -> CouplingSpec:
+    """The spec the DEM stage runs with, from the air stage's field and the DEM step plan."""
+    return CouplingSpec(
+        field=source.field,
+        field_key=source.key,
+        interval=coupling_interval(case, time_step, dump_every),
+        temperature_C=case.air.inlet_temperature_C,
+        pressure_kPa=case.air.pressure_kPa,
+        omega=source.omega,
+    )
+
+
+def driver_command(profile: LaunchProfile, processes: int, spec_name: str = COUPLING_FILE) -> list[str]:
+    """The command that runs the coupling loop under the MPI launcher."""
+    return profile.python_module_command("drumflow.coupling.driver", spec_name, processes=processes)

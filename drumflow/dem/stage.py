@@ -1,0 +1,374 @@
+"""DEM stage: LIGGGHTS deck, particle placement, the run itself, and resuming it.
+
+Entry point :func:`run` (``run(case, rundir, runner, inputs) -> DemResult``). The deck is
+rendered from the package template ``drumflow/dem/templates/drum.in.j2``; the run goes through
+:class:`drumflow.runner.Runner` under ``mpirun`` (or, with air, through the coupling loop of
+:mod:`drumflow.coupling.driver`, whose input file the coupling spec writes). An interrupted run
+restarts from its newest LIGGGHTS restart file; a finished run is reused.
+
+The time step is chosen once, by :func:`plan_run`, which the pipeline calls; the stage receives
+the plan in :class:`DemInputs`.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+import time
+from collections.abc import Callable
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from drumflow.coupling.spec import COUPLING_FILE, CouplingSpec, driver_command
+from drumflow.coupling.stop import STOP_RECORD, stop_rule
+from drumflow.dem.deck import (
+    DeckFiles,
+    StepPlan,
+    deck_context,
+    end_commands,
+    plan_steps,
+    render_deck,
+    short_plan,
+)
+from drumflow.dem.placement import place_particles, write_data_file
+from drumflow.dem.stability import (
+    LOST_PREFIX,
+    StabilityLimits,
+    StabilityMonitor,
+    stability_limits,
+)
+from drumflow.dem.thermo import ThermoParser
+from drumflow.dem.timestep import TimeStepChoice, choose_time_step
+from drumflow.errors import (
+    InsertionError,
+    LostParticlesError,
+    SolverError,
+    UnstableRunError,
+)
+from drumflow.rundir import hash_text
+from drumflow.runner import StopRun
+
+if TYPE_CHECKING:
+    from drumflow.case import Case
+    from drumflow.geometry.stage import GeometryResult
+    from drumflow.rundir import RunDir
+    from drumflow.runner import Runner
+
+__all__ = ["DemInputs", "DemResult", "ProgressCallback", "dem_key", "plan_run", "run"]
+
+#: progress(stage, done, total): simulated seconds done out of the total.
+ProgressCallback = Callable[[str, float, float], None]
+
+_LOST_RE = re.compile(r"Lost atoms")
+
+
+@dataclass(frozen=True)
+class DemInputs:
+    """What the DEM stage needs besides the case.
+
+    Attributes
+    ----------
+    geometry
+        The geometry stage's walls.
+    choice, plan
+        The time step and the step plan (:func:`plan_run`, chosen once per run).
+    processes
+        MPI processes (the launch profile's choice for the case).
+    coupling
+        Air acting on the particles; the run then goes through the coupling loop.
+    steps
+        Stop after this many DEM steps (a short start-up check of a large case); ``plan`` is
+        then already the short plan.
+    timeout
+        Wall-clock limit for LIGGGHTS, s.
+    extra_commands
+        LIGGGHTS lines run just before the main run (verification and stress scenes); they
+        are part of the stage key.
+    progress
+        ``progress("dem", simulated_s, total_s)``.
+    """
+
+    geometry: GeometryResult
+    choice: TimeStepChoice
+    plan: StepPlan
+    processes: int = 1
+    coupling: CouplingSpec | None = None
+    steps: int | None = None
+    timeout: float | None = None
+    extra_commands: str = ""
+    progress: ProgressCallback | None = None
+
+    @classmethod
+    def for_case(cls, case: Case, geometry: GeometryResult, **kwargs: Any) -> DemInputs:
+        """Inputs with the case's time step and plan (:func:`plan_run`)."""
+        choice, plan = plan_run(case, kwargs.get("steps"))
+        return cls(geometry, choice, plan, **kwargs)
+
+
+@dataclass(frozen=True)
+class DemResult:
+    time_step: float
+    steps: int
+    dump_every: int
+    snapshot_every: int
+    particles_initial: int
+    particles_final: int
+    wall_time_s: float
+    particle_steps_per_s: float
+    resumed_from_step: int | None
+    time_step_choice: dict[str, Any]
+    log: str
+    #: The 'converged' stop rule's verdict (``dem/coupling/stop.json``); None for a fixed run.
+    stop: dict[str, Any] | None = None
+
+
+def _add_loop_options(spec_path: Path, case: Case, plan: StepPlan) -> None:
+    """Give the coupling loop the 'converged' stop rule and the in-memory crossings (nothing
+    for a fixed-time run with the crossing dump: its input stays as it was)."""
+    extra: dict[str, Any] = {}
+    rule = stop_rule(case, plan.steps * plan.time_step, plan.dump_every)
+    if rule is not None:
+        extra["stop"] = rule
+    if case.run.crossings == "loop":
+        extra["crossings"] = "loop"
+    if not extra:
+        return
+    spec = json.loads(spec_path.read_text())
+    spec.update(extra, particles=case.particle_count)
+    spec_path.write_text(json.dumps(spec, indent=2))
+
+
+def _stop_record(rundir: RunDir) -> dict[str, Any] | None:
+    """The stop rule's verdict left by the coupling loop, or None."""
+    path = rundir.dem / STOP_RECORD
+    return json.loads(path.read_text()) if path.exists() else None
+
+
+def plan_run(case: Case, steps: int | None = None) -> tuple[TimeStepChoice, StepPlan]:
+    """The one choice of the DEM time step for a run, and the step plan that follows from it
+    (cut to ``steps`` for a short start-up run)."""
+    choice = choose_time_step(case)
+    plan = plan_steps(case, choice)
+    return choice, plan if steps is None else short_plan(plan, steps)
+
+
+def dem_key(case: Case, steps: int | None) -> str:
+    """What the DEM stage depends on: the whole case, and a short-run step limit."""
+    return case.hash() + (f":steps={steps}" if steps else "")
+
+
+def _stage_key(case: Case, inputs: DemInputs) -> str:
+    key = dem_key(case, inputs.steps)
+    if inputs.extra_commands:
+        key += f":extra={hash_text(inputs.extra_commands)}"
+    if inputs.coupling is not None:
+        key += inputs.coupling.key
+    return key
+
+
+def _latest_restart(folder: Path) -> tuple[Path, int] | None:
+    best: tuple[Path, int] | None = None
+    for p in folder.glob("drum.*.restart"):
+        m = re.search(r"drum\.(\d+)\.restart$", p.name)
+        if m and (best is None or int(m.group(1)) > best[1]):
+            best = (p, int(m.group(1)))
+    return best
+
+
+def _stability_record(limits: StabilityLimits, monitor: StabilityMonitor, stopped: bool) -> dict[str, Any]:
+    return {"limits": limits.as_dict(), "stopped": stopped, "warnings": list(monitor.warnings),
+            "max_overlap_m": monitor.max_overlap, "max_kinetic_energy_J": monitor.max_kinetic_energy}
+
+
+def _prepare_workdir(case: Case, rundir: RunDir, inputs: DemInputs, key: str) -> tuple[Path, int] | None:
+    """Create the DEM folders; return the restart to resume from, or start afresh (stale
+    outputs removed, particles placed)."""
+    rundir.dem_dumps.mkdir(parents=True, exist_ok=True)
+    rundir.dem_restart.mkdir(parents=True, exist_ok=True)
+    resume = None
+    if inputs.steps is None and rundir.manifest.get("dem_key") == key:
+        resume = _latest_restart(rundir.dem_restart)
+    if resume is None:
+        stale = [*rundir.dem_dumps.glob("*.txt"), *rundir.dem_restart.glob("*.restart"),
+                 *rundir.dem.glob("log.resume-*.liggghts"), *rundir.dem_coupling_logs.glob("*.csv"),
+                 *rundir.dem_coupling_logs.glob("*.json")]
+        for old in stale:
+            old.unlink()
+        positions = place_particles(case, case.particle_count)
+        box = (inputs.geometry.box_lo, inputs.geometry.box_hi)
+        write_data_file(case, positions, rundir.dem / "particles.data", box)
+    rundir.record("dem_key", key)
+    return resume
+
+
+def _write_deck(case: Case, rundir: RunDir, inputs: DemInputs,
+                resume: tuple[Path, int] | None) -> tuple[str, dict[str, Any]]:
+    """Render the deck (fresh or resume) and record what it chose; return its name and context."""
+    geometry = inputs.geometry
+    files = DeckFiles(
+        stl_file=str(Path("..") / geometry.stl),
+        lifters_stl_file=str(Path("..") / geometry.lifters_stl) if geometry.lifters_stl else "",
+        static_shell=geometry.wall_motion == "static_shell",
+    )
+    context = deck_context(
+        case,
+        inputs.plan,
+        files,
+        resume_from=None if resume is None else str(resume[0].relative_to(rundir.dem)),
+        extra_commands=inputs.extra_commands,
+        coupled=inputs.coupling is not None,
+        processes=inputs.processes,
+    )
+    deck_name = "in.drum" if resume is None else "in.drum.resume"
+    (rundir.dem / deck_name).write_text(render_deck(context))
+    rundir.record("time_step", inputs.choice.as_dict())
+    rundir.record("restitution", context["restitution_calibration"])
+    rundir.record("output_every", inputs.plan.dump_every)
+    rundir.record("processes", inputs.processes)
+    return deck_name, context
+
+
+def _finished_loop(returncode: int, lines: list[str]) -> str | None:
+    """A runner ``check``: LIGGGHTS can exit 0 after losing atoms or before its run loop."""
+    lost = next((ln for ln in reversed(lines) if _LOST_RE.search(ln)), None)
+    if lost:
+        return lost.strip()
+    if not any(line.startswith("Loop time") for line in lines):
+        return "LIGGGHTS stopped before finishing its run loop"
+    return None
+
+
+class _RowWatcher:
+    """Every thermo row goes to the progress bar and to the stability monitor, which stops the
+    run at the first row that breaks a physical bound."""
+
+    def __init__(self, case: Case, inputs: DemInputs, own_log: Path) -> None:
+        total = inputs.plan.steps * inputs.plan.time_step
+        progress = inputs.progress
+        self.parser = ThermoParser(
+            on_time=(lambda t, _n: progress("dem", min(t, total), total)) if progress else None
+        )
+        self.limits = stability_limits(case)
+        self.monitor = StabilityMonitor(self.limits, forced_time_step=inputs.choice.mode == "forced")
+        self.particles = case.particle_count
+        self.own_log = own_log
+        self.command: list[str] = []
+
+    def __call__(self, line: str) -> None:
+        before = len(self.parser.rows)
+        self.parser(line)
+        if len(self.parser.rows) == before:
+            return
+        row = self.parser.rows[-1]
+        diagnosis = self.monitor.check(int(row[0]), row[1], int(row[2]), row[3], row[4], row[6])
+        if diagnosis and diagnosis.startswith(LOST_PREFIX):
+            raise StopRun(LostParticlesError(self.particles, int(row[2]), self.own_log, self.command,
+                                             time_s=row[1]))
+        if diagnosis:
+            raise StopRun(UnstableRunError(diagnosis, int(row[0]), self.own_log, self.command))
+
+    def record(self, stopped: bool) -> dict[str, Any]:
+        return _stability_record(self.limits, self.monitor, stopped)
+
+
+def _launch(case: Case, rundir: RunDir, runner: Runner, inputs: DemInputs, deck_name: str,
+            context: dict[str, Any], suffix: str) -> tuple[_RowWatcher, Path, float]:
+    """Run LIGGGHTS (or the coupling loop) with the stability monitor; return the watcher, the
+    standard-output log and the wall time."""
+    work = rundir.dem
+    # LIGGGHTS writes (and flushes) its own log, which feeds the progress bar; the runner
+    # keeps standard output separately.
+    own_log = work / f"log{suffix}.liggghts"
+    log = work / f"liggghts{suffix}.out"
+    if own_log.exists():
+        own_log.unlink()
+    if inputs.coupling is None:
+        command = runner.profile.liggghts_command(deck_name, own_log.name, inputs.processes)
+    else:
+        spec_path = inputs.coupling.write_driver_file(work, deck_name, own_log.name,
+                                                      inputs.plan.steps, inputs.plan.time_step,
+                                                      end_commands(context))
+        _add_loop_options(spec_path, case, inputs.plan)
+        command = driver_command(runner.profile, inputs.processes, COUPLING_FILE)
+    watcher = _RowWatcher(case, inputs, own_log)
+    watcher.command = command
+    t0 = time.perf_counter()
+    try:
+        runner.run("liggghts", command, work, log, timeout=inputs.timeout, on_line=watcher,
+                   check=_finished_loop, follow=own_log)
+    except (UnstableRunError, LostParticlesError):
+        rundir.record("stability", watcher.record(stopped=True))
+        raise
+    except SolverError as err:
+        if _LOST_RE.search(f"{err.reason} {err.last_error}"):
+            rows = watcher.parser.rows
+            last = rows[-1] if rows else None
+            n = case.particle_count
+            final = int(last[2]) if last is not None and int(last[2]) < n else None
+            raise LostParticlesError(
+                n, final, log, command, time_s=None if last is None else last[1]
+            ) from None
+        raise
+    finally:
+        rundir.record_commands([r.as_dict() for r in runner.records if r.program == "liggghts"][-1:])
+    wall = time.perf_counter() - t0
+    rundir.record("stability", watcher.record(stopped=False))
+    return watcher, log, wall
+
+
+def run(case: Case, rundir: RunDir, runner: Runner, inputs: DemInputs) -> DemResult:
+    """Run (or resume, or reuse) the DEM stage.
+
+    Raises
+    ------
+    UnstableRunError
+        The stability monitor stopped the run (diagnosis in the message).
+    LostParticlesError
+        Particles left the domain.
+    InsertionError
+        LIGGGHTS read fewer particles than were placed.
+    SolverError
+        LIGGGHTS failed otherwise.
+    """
+    key = _stage_key(case, inputs)
+    done = rundir.stage_done("dem", key)
+    if done:
+        return DemResult(**done["result"])
+    resume = _prepare_workdir(case, rundir, inputs, key)
+    deck_name, context = _write_deck(case, rundir, inputs, resume)
+    suffix = "" if resume is None else f".resume-{resume[1]}"
+    watcher, log, wall = _launch(case, rundir, runner, inputs, deck_name, context, suffix)
+    rows = watcher.parser.rows
+    n = case.particle_count
+    first_atoms = int(rows[0][2]) if rows else 0
+    if resume is None and first_atoms != n:
+        # read_data silently skips atoms outside the box: the count must be exact at step 0.
+        raise InsertionError(n, first_atoms, "LIGGGHTS read fewer particles than were placed")
+    final_atoms = int(rows[-1][2]) if rows else n
+    if final_atoms != n:
+        # The stability monitor should have stopped the run at the first row with fewer atoms;
+        # this is a second line of defence, e.g. against a deck edited by hand.
+        raise LostParticlesError(n, final_atoms, log, watcher.command)
+    plan = inputs.plan
+    stop = _stop_record(rundir)
+    steps = int(stop["step"]) if stop else plan.steps
+    if stop:
+        rundir.record("stop", stop)
+    steps_run = steps - (resume[1] if resume else 0)
+    result = DemResult(
+        time_step=plan.time_step,
+        steps=steps,
+        dump_every=plan.dump_every,
+        snapshot_every=plan.snapshot_every,
+        particles_initial=n,
+        particles_final=final_atoms,
+        wall_time_s=wall,
+        particle_steps_per_s=n * steps_run / wall if wall > 0 else 0.0,
+        resumed_from_step=None if resume is None else resume[1],
+        time_step_choice=inputs.choice.as_dict(),
+        log=str(log.relative_to(rundir.root)),
+        stop=stop,
+    )
+    rundir.mark_done("dem", key, asdict(result), wall)
+    return result

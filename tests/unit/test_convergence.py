@@ -1,0 +1,159 @@
+"""Confidence intervals for autocorrelated series (drumflow.convergence).
+
+Reference: an AR(1) series x_t = phi x_{t-1} + e_t (e_t standard normal, started in its
+stationary law) has mean 0, autocorrelation phi^k and integrated autocorrelation time
+(1 + phi) / (1 - phi); the exact variance of the mean of n samples is
+sigma^2 / n^2 * sum_{|k|<n} (n - |k|) phi^|k| with sigma^2 = 1 / (1 - phi^2). Coverage is
+counted over many seeds: a 95% interval must contain the true mean 0 in about 95% of them.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from numpy.typing import NDArray
+from scipy.signal import lfilter
+
+from drumflow.convergence import (
+    batch_means,
+    convergence_state,
+    effective_sample_size_interval,
+    integrated_autocorrelation_time,
+    naive_interval,
+)
+
+SEEDS = 400
+# Binomial standard error of a 95% coverage over 400 seeds: sqrt(0.95 * 0.05 / 400) = 0.011.
+# The accepted band 0.91-0.98 is about 3.5 standard errors below and 2.7 above; batch means
+# with batches 10 tau long are known to under-cover by 1-2 points (bias of the batch variance).
+LOW, HIGH = 0.91, 0.98
+
+
+def ar1(phi: float, n: int, seeds: int, offset: int = 0) -> NDArray[np.float64]:
+    """``seeds`` independent stationary AR(1) series of length ``n``, one per row."""
+    rng = np.random.default_rng(12345 + offset)
+    e = rng.standard_normal((seeds, n))
+    e[:, 0] /= math.sqrt(1.0 - phi**2)  # the stationary variance for the first sample
+    return np.asarray(lfilter([1.0], [1.0, -phi], e, axis=1))
+
+
+def exact_variance_of_mean(phi: float, n: int) -> float:
+    k = np.arange(1, n)
+    return (1.0 + 2.0 * float(np.sum((n - k) / n * phi**k))) / (n * (1.0 - phi**2))
+
+
+def coverage(intervals: list) -> float:
+    return float(np.mean([iv.low <= 0.0 <= iv.high for iv in intervals]))
+
+
+def test_naive_interval_under_covers_and_batch_means_covers() -> None:
+    phi, n = 0.9, 4000  # tau = 19 samples; 20 batches of 200 samples = 10.5 tau each
+    xs = ar1(phi, n, SEEDS)
+    naive = [naive_interval(x) for x in xs]
+    bm = [batch_means(x) for x in xs]
+    # The naive half-width is too narrow by sqrt(tau) = 4.4: coverage near 2 Phi(1.96/4.4) - 1
+    # = 0.34.
+    assert coverage(naive) < 0.5
+    assert LOW <= coverage(bm) <= HIGH
+    # The batch-means variance of the mean agrees with the exact one (mean over seeds of
+    # (half/t)^2, 19 degrees of freedom: standard error of the average about 0.32/sqrt(400)
+    # = 1.6%; allowed 10% for the finite-batch bias).
+    from scipy import stats
+
+    t = stats.t.ppf(0.975, 19)
+    estimated = float(np.mean([(iv.half_width / t) ** 2 for iv in bm]))
+    assert estimated == pytest.approx(exact_variance_of_mean(phi, n), rel=0.10)
+
+
+def test_effective_sample_size_interval_covers() -> None:
+    phi, n = 0.8, 4000  # tau = 9
+    xs = ar1(phi, n, SEEDS, offset=1)
+    ess = [effective_sample_size_interval(x) for x in xs]
+    assert all(iv.batches_independent for iv in ess)
+    assert LOW <= coverage(ess) <= HIGH
+
+
+def test_integrated_autocorrelation_time_of_ar1() -> None:
+    # Sokal's window estimate: relative standard error about sqrt(2 (2M + 1) / n) = 0.14 for
+    # one series with M = 5 tau = 95, n = 20,000; over 100 series 1.4%, so 5% is 3.5 standard
+    # errors (measured: 18.9 +- 0.23 over another 100 seeds, no visible bias).
+    phi = 0.9
+    xs = ar1(phi, 20_000, 100, offset=2)
+    taus = [integrated_autocorrelation_time(x) for x in xs]
+    assert float(np.mean(taus)) == pytest.approx((1 + phi) / (1 - phi), rel=0.05)
+    assert integrated_autocorrelation_time(np.ones(10)) != integrated_autocorrelation_time(np.ones(10))
+
+
+def test_short_batches_are_flagged_as_correlated() -> None:
+    # tau = 1999 samples against batches of 100: the batch means follow one slow wave.
+    phi = 0.999
+    xs = ar1(phi, 2000, 50, offset=3)
+    flagged = [not batch_means(x).batches_independent for x in xs]
+    assert np.mean(flagged) > 0.9
+    # Independent samples pass the check in about 95% of series (its level is 5%).
+    white = np.random.default_rng(7).standard_normal((SEEDS, 400))
+    passed = np.mean([batch_means(x).batches_independent for x in white])
+    assert 0.90 <= passed <= 0.99
+
+
+def test_weights_give_the_time_mean() -> None:
+    x = np.array([1.0, 1.0, 1.0, 1.0, 4.0] * 40)
+    w = np.array([1.0, 1.0, 1.0, 1.0, 2.0] * 40)
+    iv = batch_means(x, w, n_batches=8)
+    assert iv.mean == pytest.approx((4 * 1.0 + 2 * 4.0) / 6.0)
+    # Every batch holds whole periods of the pattern: identical batch means, zero width.
+    assert iv.half_width == pytest.approx(0.0, abs=1e-12)
+    with pytest.raises(ValueError, match="weights"):
+        batch_means(x, w[:-1])
+
+
+def test_too_few_samples_give_no_interval() -> None:
+    iv = batch_means(np.arange(50.0))  # 2 samples per batch < MIN_BATCH_SAMPLES
+    assert math.isnan(iv.half_width)
+    assert math.isnan(iv.relative_half_width)
+
+
+def test_stop_rule() -> None:
+    rng = np.random.default_rng(11)
+    h = 50.0 + rng.standard_normal(2000)  # +-0.05 / 50: relative width about 0.1%
+    flow = 2.0 + 0.5 * rng.standard_normal(2000)  # relative width about 1.1%
+    series = {"h": (h, None), "falling_mass_flow": (flow, None)}
+    early = convergence_state(series, time_s=1.0, tolerance=0.05, min_time_s=2.0)
+    assert not early.converged and "minimum time" in early.reason
+    tight = convergence_state(series, time_s=3.0, tolerance=0.005, min_time_s=2.0)
+    assert not tight.converged and tight.reason.startswith("falling_mass_flow")
+    loose = convergence_state(series, time_s=3.0, tolerance=0.02, min_time_s=2.0)
+    assert loose.converged, loose.reason
+    record = loose.as_dict()
+    assert record["intervals"]["h"]["relative_half_width"] < 0.002
+    # A drifting series (not stationary) has correlated batch means: no verdict of convergence
+    # however small the noise.
+    drift = np.linspace(1.0, 1.002, 2000) + 1e-5 * rng.standard_normal(2000)
+    verdict = convergence_state({"h": (drift, None)}, 3.0, 0.05, 0.0)
+    assert not verdict.converged and "correlated" in verdict.reason
+
+
+# -- the case fields of the stop rule -------------------------------------------------------
+def test_stop_rule_case_fields() -> None:
+    from drumflow.case import case_from_dict
+    from drumflow.coupling.stop import min_stop_time
+    from drumflow.errors import CaseError
+    from drumflow.verify.scenes import tiny_drum_dict
+
+    fixed = case_from_dict(tiny_drum_dict())
+    # A fixed-time case keeps the hash it had before the rule existed (its run directories and
+    # caches stay valid): the stop fields are left out of the canonical JSON.
+    assert "stop" not in fixed.canonical_json()
+    converged = case_from_dict(tiny_drum_dict(air__model="uniform", run__stop="converged"))
+    assert converged.hash() != fixed.hash()
+    # 'auto': mass_flow_start 0.6 s + max(1 s, 3 x 60 / (30 rpm x 6 lifters) = 1 s).
+    assert min_stop_time(converged) == pytest.approx(1.6)
+    with pytest.raises(CaseError, match=r"run.stop = 'converged': needs air"):
+        case_from_dict(tiny_drum_dict(run__stop="converged"))
+    with pytest.raises(CaseError, match=r"run.stop_min_time = 5.0 s: must be above"):
+        case_from_dict(tiny_drum_dict(air__model="uniform", run__stop="converged",
+                                      run__stop_min_time=5.0))
+    with pytest.raises(CaseError, match=r"run.stop_tolerance = 0.0"):
+        case_from_dict(tiny_drum_dict(air__model="uniform", run__stop_tolerance=0.0))
