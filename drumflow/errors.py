@@ -43,6 +43,36 @@ class GeometryError(DrumflowError, ValueError):
     """The drum geometry could not be built or failed its checks (open shell, bad facets)."""
 
 
+class SweepError(CaseError):
+    """A sweep file is invalid, or one of its members is a case the solver would refuse.
+
+    A :class:`CaseError` (so a ``ValueError``: exit code 2), with every problem on its own
+    line, each naming the member (when it is about one), the field, the value and the allowed
+    range.
+    """
+
+    def __init__(self, problems: Sequence[str], source: Path | str | None = None) -> None:
+        super().__init__(problems, source)
+        where = f" in {self.source}" if self.source else ""
+        lines = "\n".join(f"  - {p}" for p in self.problems)
+        self.args = (f"invalid sweep{where}:\n{lines}",)
+
+    def __str__(self) -> str:
+        return str(self.args[0])
+
+
+class SlurmError(DrumflowError, RuntimeError):
+    """A SLURM command failed (sbatch refused the job, squeue could not reach the controller)."""
+
+
+class DrumModelError(DrumflowError, ValueError):
+    """The whole-drum model cannot run at these conditions (the message names the quantity)."""
+
+
+class GrateConvergenceError(DrumflowError, RuntimeError):
+    """The grate cooler's sweeps did not reach the case's tolerances (a failed run, exit code 1)."""
+
+
 class SolverError(DrumflowError, RuntimeError):
     """An external program (LIGGGHTS, an OpenFOAM utility, mpirun) failed.
 

@@ -437,6 +437,119 @@ def _reynolds(
     return v_max * point.particle_diameter_m / nu, vf, v_ai, v_max
 
 
+@dataclass(frozen=True)
+class _ReferenceBasis:
+    """What the prediction scales from: the reference section's fall, area and air temperature."""
+
+    falling_mass_flow_kg_s: float
+    area_m2: float
+    property_temperature_c: float
+    measured_h_w_m2k: float | None
+    notes: tuple[str, ...] = ()
+
+
+def _correlation_or_fixed_h(
+    correlation_or_h: NusseltCorrelation | float,
+) -> tuple[NusseltCorrelation | None, float]:
+    """``(correlation, nan)`` for a fitted correlation, ``(None, h)`` for a fixed coefficient."""
+    if isinstance(correlation_or_h, NusseltCorrelation):
+        return correlation_or_h, math.nan
+    if isinstance(correlation_or_h, (int, float)) and not isinstance(correlation_or_h, bool):
+        return None, check_positive("correlation_or_h", correlation_or_h)
+    raise AnalysisInputError(
+        "correlation_or_h",
+        type(correlation_or_h).__name__,
+        "a NusseltCorrelation or a heat-transfer coefficient in W/(m2 K)",
+    )
+
+
+def _new_operating_point(
+    ref: OperatingPoint,
+    rpm: float | None,
+    air_mass_flow: float | None,
+    feed_rate: float | None,
+    particle_diameter: float | None,
+) -> OperatingPoint:
+    """The reference point with the given values replaced (each checked finite and positive)."""
+    check_positive("air.mass_flow of the case", ref.air_mass_flow_kg_s)
+    return OperatingPoint(
+        rpm=ref.rpm if rpm is None else check_positive("rpm", rpm),
+        air_mass_flow_kg_s=ref.air_mass_flow_kg_s
+        if air_mass_flow is None
+        else check_positive("air_mass_flow", air_mass_flow),
+        feed_rate_kg_s=ref.feed_rate_kg_s
+        if feed_rate is None
+        else check_positive("feed_rate", feed_rate),
+        particle_diameter_m=ref.particle_diameter_m
+        if particle_diameter is None
+        else check_positive("particle_diameter", particle_diameter),
+    )
+
+
+def _check_not_centrifuging(case: Case, rpm: float) -> None:
+    """Refuse a speed at which the bed would stick to the shell (Froude >= 1): no curtain."""
+    omega = rpm * 2.0 * math.pi / 60.0
+    froude = omega**2 * case.drum.radius / 9.81
+    if froude >= 1.0:
+        limit = 60.0 / (2.0 * math.pi) * math.sqrt(9.81 / case.drum.radius)
+        raise AnalysisInputError(
+            "rpm", rpm, f"a speed below {limit:.3g} rpm (Froude {froude:.3g} >= 1: centrifuging)"
+        )
+
+
+def _reference_basis(
+    case: Case,
+    ref: OperatingPoint,
+    reference: MethodologyResult | None,
+    falling_mass_flow_kg_s: float | None,
+) -> _ReferenceBasis:
+    """The reference fall, ``A_he`` and air property temperature, from a run or a mass flow."""
+    if reference is not None:
+        valid = reference.steps["valid"].to_numpy(dtype=bool)
+        notes: tuple[str, ...] = ()
+        if reference.case.hash() != case.hash():
+            notes = (
+                f"the reference run's case ({reference.case.name}) differs from the case given "
+                f"({case.name}); the reference falling mass flow and area are used as they are",
+            )
+        return _ReferenceBasis(
+            falling_mass_flow_kg_s=reference.falling_mass_flow_kg_s,
+            area_m2=reference.exchanger_area_m2,
+            property_temperature_c=float(
+                reference.steps["mean_air_temperature_C"].to_numpy()[valid].mean()),
+            measured_h_w_m2k=reference.h_mean_w_m2k,
+            notes=notes,
+        )
+    f_ref = check_positive("falling_mass_flow_kg_s", falling_mass_flow_kg_s)
+    # Eq. 46 with m_mf = F * dt is independent of dt: evaluate it for dt = 1 s.
+    one_second = 1.0
+    area = float(falling_particle_area(f_ref * one_second, ref.particle_diameter_m,
+                                       case.particles.density))
+    area *= case.plant.length / case.drum.length / one_second
+    return _ReferenceBasis(
+        falling_mass_flow_kg_s=f_ref,
+        area_m2=area,
+        property_temperature_c=float(case.air.inlet_temperature_C),
+        measured_h_w_m2k=None,
+    )
+
+
+def _range_warnings(correlation: NusseltCorrelation, re: float, pr: float) -> list[CorrelationRangeWarning]:
+    """Warnings for an ``Re`` outside the fitted range or a ``Pr`` well outside it."""
+    found: list[CorrelationRangeWarning] = []
+    lo, hi = correlation.reynolds_range
+    if not lo <= re <= hi:
+        found.append(CorrelationRangeWarning(
+            f"Re = {re:.5g} is outside the correlation's range [{lo:.5g}, {hi:.5g}]: "
+            "the predicted h is an extrapolation"))
+    p_lo, p_hi = correlation.prandtl_range
+    if pr < p_lo * (1.0 - _PRANDTL_RTOL) or pr > p_hi * (1.0 + _PRANDTL_RTOL):
+        found.append(CorrelationRangeWarning(
+            f"Pr = {pr:.4g} is more than {_PRANDTL_RTOL:.0%} outside the correlation's range "
+            f"[{p_lo:.4g}, {p_hi:.4g}]"))
+    return found
+
+
 def predict_plant(
     correlation_or_h: NusseltCorrelation | float,
     case: Case,
@@ -497,73 +610,23 @@ def predict_plant(
             "both given" if reference is not None else "none given",
             "exactly one: the reference run's methodology result or its falling mass flow",
         )
-    if isinstance(correlation_or_h, NusseltCorrelation):
-        correlation: NusseltCorrelation | None = correlation_or_h
-        fixed_h = math.nan
-    elif isinstance(correlation_or_h, (int, float)) and not isinstance(correlation_or_h, bool):
-        correlation = None
-        fixed_h = check_positive("correlation_or_h", correlation_or_h)
-    else:
-        raise AnalysisInputError(
-            "correlation_or_h",
-            type(correlation_or_h).__name__,
-            "a NusseltCorrelation or a heat-transfer coefficient in W/(m2 K)",
-        )
-
+    correlation, fixed_h = _correlation_or_fixed_h(correlation_or_h)
     plant = PlantSpec.from_case(case)
     ref = plant.operating_point()
-    new = OperatingPoint(
-        rpm=ref.rpm if rpm is None else check_positive("rpm", rpm),
-        air_mass_flow_kg_s=ref.air_mass_flow_kg_s
-        if air_mass_flow is None
-        else check_positive("air_mass_flow", air_mass_flow),
-        feed_rate_kg_s=ref.feed_rate_kg_s
-        if feed_rate is None
-        else check_positive("feed_rate", feed_rate),
-        particle_diameter_m=ref.particle_diameter_m
-        if particle_diameter is None
-        else check_positive("particle_diameter", particle_diameter),
-    )
-    check_positive("air.mass_flow of the case", ref.air_mass_flow_kg_s)
-    omega = new.rpm * 2.0 * math.pi / 60.0
-    froude = omega**2 * case.drum.radius / 9.81
-    if froude >= 1.0:
-        limit = 60.0 / (2.0 * math.pi) * math.sqrt(9.81 / case.drum.radius)
-        raise AnalysisInputError(
-            "rpm", new.rpm, f"a speed below {limit:.3g} rpm (Froude {froude:.3g} >= 1: centrifuging)"
-        )
-
-    notes: list[str] = []
-    range_warnings: list[CorrelationRangeWarning] = []
-    if reference is not None:
-        f_ref = reference.falling_mass_flow_kg_s
-        a_ref = reference.exchanger_area_m2
-        valid = reference.steps["valid"].to_numpy(dtype=bool)
-        property_t = float(reference.steps["mean_air_temperature_C"].to_numpy()[valid].mean())
-        measured_h: float | None = reference.h_mean_w_m2k
-        if reference.case.hash() != case.hash():
-            notes.append(
-                f"the reference run's case ({reference.case.name}) differs from the case given "
-                f"({case.name}); the reference falling mass flow and area are used as they are"
-            )
-    else:
-        f_ref = check_positive("falling_mass_flow_kg_s", falling_mass_flow_kg_s)
-        # Eq. 46 with m_mf = F * dt is independent of dt: evaluate it for dt = 1 s.
-        one_second = 1.0
-        a_ref = float(falling_particle_area(f_ref * one_second, ref.particle_diameter_m,
-                                           case.particles.density))
-        a_ref *= case.plant.length / case.drum.length / one_second
-        property_t = float(case.air.inlet_temperature_C)
-        measured_h = None
+    new = _new_operating_point(ref, rpm, air_mass_flow, feed_rate, particle_diameter)
+    _check_not_centrifuging(case, new.rpm)
+    basis = _reference_basis(case, ref, reference, falling_mass_flow_kg_s)
+    notes = list(basis.notes)
 
     # Assumptions 1-3.
     fall_ratio = (new.feed_rate_kg_s / ref.feed_rate_kg_s) * (new.rpm / ref.rpm)
-    f_new = f_ref * fall_ratio
-    a_new = a_ref * fall_ratio * (ref.particle_diameter_m / new.particle_diameter_m)
+    f_new = basis.falling_mass_flow_kg_s * fall_ratio
+    a_new = basis.area_m2 * fall_ratio * (ref.particle_diameter_m / new.particle_diameter_m)
     v_m_ref = particle_volume(case.particle_count, ref.particle_diameter_m)
     v_m_new = v_m_ref * (new.feed_rate_kg_s / ref.feed_rate_kg_s)
 
     # Assumptions 4-6.
+    property_t = basis.property_temperature_c
     re_ref, vf_ref, _, _ = _reynolds(case, ref, v_m_ref, property_t)
     re_new, vf_new, v_ai, v_max = _reynolds(case, new, v_m_new, property_t)
     pr = float(air.prandtl(property_t, name="air property temperature"))
@@ -571,33 +634,17 @@ def predict_plant(
         k = float(case.particles.conductivity)
     else:
         k = float(air.thermal_conductivity(property_t, name="air property temperature"))
-
-    changed = new != ref
     if correlation is not None:
         nu_new = float(correlation.predict(re_new, pr, warn=False))
-        nu_ref = float(correlation.predict(re_ref, pr, warn=False))
         h_new = nu_new * k / new.particle_diameter_m
-        h_ref = nu_ref * k / ref.particle_diameter_m
-        lo, hi = correlation.reynolds_range
-        if not lo <= re_new <= hi:
-            msg = (
-                f"Re = {re_new:.5g} is outside the correlation's range [{lo:.5g}, {hi:.5g}]: "
-                "the predicted h is an extrapolation"
-            )
-            range_warnings.append(CorrelationRangeWarning(msg))
-            notes.append(msg)
-        p_lo, p_hi = correlation.prandtl_range
-        if pr < p_lo * (1.0 - _PRANDTL_RTOL) or pr > p_hi * (1.0 + _PRANDTL_RTOL):
-            msg = (
-                f"Pr = {pr:.4g} is more than {_PRANDTL_RTOL:.0%} outside the correlation's range "
-                f"[{p_lo:.4g}, {p_hi:.4g}]"
-            )
-            range_warnings.append(CorrelationRangeWarning(msg))
-            notes.append(msg)
+        h_ref = float(correlation.predict(re_ref, pr, warn=False)) * k / ref.particle_diameter_m
+        range_warnings = _range_warnings(correlation, re_new, pr)
+        notes.extend(str(w) for w in range_warnings)
     else:
         h_new = h_ref = fixed_h
         nu_new = h_new * new.particle_diameter_m / k
-        if changed:
+        range_warnings = []
+        if new != ref:
             notes.append(
                 f"h held at {fixed_h:.4g} W/(m2 K): the prediction ignores how h changes with Re "
                 f"(here {re_ref:.4g} -> {re_new:.4g}); use a fitted correlation for larger changes"
@@ -611,7 +658,7 @@ def predict_plant(
                         air_mass_flow_kg_s=new.air_mass_flow_kg_s).streams(),
     )
     reference_exchanger = solve_outlet_temperature(
-        h_w_m2k=h_ref, area_m2=a_ref, **plant.streams()
+        h_w_m2k=h_ref, area_m2=basis.area_m2, **plant.streams()
     )
     return Prediction(
         h_source="correlation" if correlation is not None else "fixed",
@@ -629,11 +676,11 @@ def predict_plant(
         nusselt=nu_new,
         h_w_m2k=h_new,
         reference_h_w_m2k=h_ref,
-        measured_h_w_m2k=measured_h,
+        measured_h_w_m2k=basis.measured_h_w_m2k,
         falling_mass_flow_kg_s=f_new,
-        reference_falling_mass_flow_kg_s=f_ref,
+        reference_falling_mass_flow_kg_s=basis.falling_mass_flow_kg_s,
         exchanger_area_m2=a_new,
-        reference_exchanger_area_m2=a_ref,
+        reference_exchanger_area_m2=basis.area_m2,
         exchanger=exchanger,
         reference_exchanger=reference_exchanger,
         range_warnings=range_warnings,

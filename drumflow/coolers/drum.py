@@ -58,7 +58,7 @@ from drumflow.coolers._propagator import exposure_matrix
 from drumflow.coolers._transport import TransportLaw
 from drumflow.coolers.particle_interior import Sphere, SphereConduction
 from drumflow.coupling.physics import AirState, ranz_marshall_h
-from drumflow.errors import DrumflowError
+from drumflow.errors import DrumModelError
 
 FloatArray = NDArray[np.float64]
 
@@ -77,10 +77,6 @@ __all__ = [
 #: Conductivity standing for a lumped particle (Bi -> 0), W/(m K).
 LUMPED_CONDUCTIVITY = 1.0e4
 _PRESSURE_KPA = 101.325
-
-
-class DrumModelError(DrumflowError, ValueError):
-    """The drum model cannot run at these conditions (the message names the quantity)."""
 
 
 @dataclass(frozen=True)

@@ -35,7 +35,7 @@ from datetime import datetime
 from pathlib import Path
 from typing import Any
 
-from drumflow.errors import DrumflowError
+from drumflow.errors import SlurmError
 from drumflow.sweep.executor import Attempt, Executor, Ledger
 from drumflow.sweep.spec import Member, Runs, SlurmSettings, SweepError, member_id
 
@@ -44,10 +44,6 @@ __all__ = ["SlurmError", "SlurmExecutor", "array_spec", "slurm_version"]
 #: SLURM job states and what they mean for an attempt.
 _PENDING = {"PENDING", "REQUEUED", "REQUEUE_FED", "REQUEUE_HOLD", "RESV_DEL_HOLD", "CONFIGURING"}
 _RUNNING = {"RUNNING", "COMPLETING", "SUSPENDED", "STOPPED", "SIGNALING", "STAGE_OUT", "RESIZING"}
-
-
-class SlurmError(DrumflowError, RuntimeError):
-    """A SLURM command failed (sbatch refused the job, squeue could not reach the controller)."""
 
 
 def slurm_version() -> str | None:

@@ -41,7 +41,7 @@ from typing import Any, Literal
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from drumflow.case import Case, case_from_dict, case_to_toml, read_toml, validate_model
-from drumflow.errors import CaseError
+from drumflow.errors import CaseError, SweepError
 
 __all__ = [
     "AxisRange",
@@ -54,24 +54,6 @@ __all__ = [
 ]
 
 _RANGE_KEYS = frozenset({"start", "stop", "num", "step"})
-
-
-class SweepError(CaseError):
-    """A sweep file is invalid, or one of its members is a case the solver would refuse.
-
-    A :class:`~drumflow.errors.CaseError` (so a ``ValueError``: exit code 2), with every
-    problem on its own line, each naming the member (when it is about one), the field, the
-    value and the allowed range.
-    """
-
-    def __init__(self, problems: list[str], source: Path | str | None = None) -> None:
-        super().__init__(problems, source)
-        where = f" in {self.source}" if self.source else ""
-        lines = "\n".join(f"  - {p}" for p in self.problems)
-        self.args = (f"invalid sweep{where}:\n{lines}",)
-
-    def __str__(self) -> str:
-        return str(self.args[0])
 
 
 class _Section(BaseModel):

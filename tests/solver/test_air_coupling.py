@@ -9,7 +9,7 @@ import sys
 from pathlib import Path
 
 import pytest
-from conftest import LIGGGHTS, OPENFOAM, requires_solver
+from support.solvers import LIGGGHTS, OPENFOAM, requires_solver
 
 pytestmark = [
     pytest.mark.solver,

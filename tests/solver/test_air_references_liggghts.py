@@ -12,7 +12,7 @@ import textwrap
 from pathlib import Path
 
 import pytest
-from conftest import LIGGGHTS, requires_solver
+from support.solvers import LIGGGHTS, requires_solver
 
 from drumflow.runner import Runner
 from drumflow.verify.single_particle import SETTLING_DIAMETERS, convective_h_check, settling_check

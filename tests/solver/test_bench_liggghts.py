@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pandas as pd
 import pytest
-from conftest import LIGGGHTS, requires_solver, tiny_case_dict
+from support.solvers import LIGGGHTS, requires_solver, tiny_case_dict
 
 from drumflow.bench import run_bench
 from drumflow.case import case_from_dict

@@ -10,7 +10,7 @@ import math
 from pathlib import Path
 
 import pytest
-from conftest import LIGGGHTS, requires_solver, tiny_case_dict
+from support.solvers import LIGGGHTS, requires_solver, tiny_case_dict
 
 from drumflow.analysis.closures import extract_closures, load_closures
 from drumflow.case import case_from_dict

@@ -7,7 +7,7 @@ import math
 from pathlib import Path
 
 import pytest
-from conftest import LIGGGHTS, requires_solver
+from support.solvers import LIGGGHTS, requires_solver
 
 from drumflow.dem.conduction import GEOMETRIC_AREA_FACTOR
 from drumflow.runner import Runner

@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 import pytest
-from conftest import LIGGGHTS, requires_solver
+from support.solvers import LIGGGHTS, requires_solver
 
 pytestmark = [pytest.mark.solver, requires_solver(*LIGGGHTS)]
 

@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
-from conftest import LIGGGHTS, requires_solver, tiny_case_dict
+from support.solvers import LIGGGHTS, requires_solver, tiny_case_dict
 
 from drumflow import dem
 from drumflow.case import case_from_dict, load_case

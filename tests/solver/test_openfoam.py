@@ -14,7 +14,7 @@ from typing import Any
 
 import numpy as np
 import pytest
-from conftest import CASES, OPENFOAM, requires_solver
+from support.solvers import CASES, OPENFOAM, requires_solver
 
 from drumflow.air.field import AirField, plot_air_cross_section
 from drumflow.air.foam import AirNotConvergedError, AirSolution, solve_air

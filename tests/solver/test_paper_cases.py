@@ -10,7 +10,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from conftest import LIGGGHTS, OPENFOAM, requires_solver
+from support.solvers import LIGGGHTS, OPENFOAM, requires_solver
 
 from drumflow.case import case_from_dict, load_case
 from drumflow.pipeline import post_run, run_case

@@ -19,7 +19,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from conftest import LIGGGHTS, OPENFOAM, requires_solver
+from support.solvers import LIGGGHTS, OPENFOAM, requires_solver
 
 from drumflow.case import case_to_toml
 from drumflow.verify.scenes import tiny_drum

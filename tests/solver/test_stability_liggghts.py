@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
-from conftest import LIGGGHTS, requires_solver, tiny_case_dict
+from support.solvers import LIGGGHTS, requires_solver, tiny_case_dict
 
 from drumflow.case import case_from_dict
 from drumflow.dem.dumps import read_series

@@ -106,15 +106,11 @@ from drumflow.coolers.grate.properties import (
     packed_bed_h,
 )
 from drumflow.coolers.grate.tdma import tdma
-from drumflow.errors import DrumflowError
+from drumflow.errors import GrateConvergenceError
 
 __all__ = ["ClinkerProperties", "GrateConvergenceError", "GrateSolution", "solve_grate"]
 
 FloatArray = NDArray[np.float64]
-
-
-class GrateConvergenceError(DrumflowError, RuntimeError):
-    """The sweeps did not reach the case's tolerances (a failed run, exit code 1)."""
 
 
 @dataclass(frozen=True)
