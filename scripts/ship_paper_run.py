@@ -14,6 +14,8 @@ Copies from a ``drumflow run`` directory (finished, or interrupted and post-proc
 * ``post/methodology.json`` and ``post/steps.csv`` (the paper's particle conductivity in Nu),
   when the run is long enough for the methodology; else the reason goes into the record;
 * ``air/solution.json`` (the OpenFOAM solve: cells, residuals, mass flows);
+* ``post/particles_times.png``: Figure 6 as the paper draws it, the section at up to four
+  snapshot times on one colour scale (drawn here: the snapshots are not shipped);
 * ``post/air_side.json``: the bed and airborne h of the last snapshot in the run's air field,
   and ``post/particles_3d.png`` (Figure 6), both computed here because the snapshot and the
   100 MB air field are not shipped;
@@ -44,9 +46,11 @@ from drumflow.report.paper import (
     AIR_SIDE,
     CROSSINGS_SUMMARY,
     PARTICLES_3D,
+    PARTICLES_TIMES,
     RUN_RECORD,
     air_side_of_run,
     render_last_snapshot,
+    render_snapshot_panels,
     run_record,
 )
 from drumflow.rundir import RunDir
@@ -144,6 +148,11 @@ def ship(run_dir: Path, dest: Path, *, render_3d: bool = True, crossings_limit_m
             render_last_snapshot(run, case, dest / "post" / PARTICLES_3D, timeout_s=600.0)
         except (DrumflowError, OSError) as exc:
             notes.append(f"Figure 6 not rendered: {exc}")
+
+    try:
+        render_snapshot_panels(run, case, dest / "post" / PARTICLES_TIMES)
+    except (DrumflowError, OSError) as exc:
+        notes.append(f"Figure 6 (snapshots over time) not drawn: {exc}")
 
     record = run_record(run.root)
     files = sorted(p for p in dest.rglob("*") if p.is_file() and p.name != RUN_RECORD)

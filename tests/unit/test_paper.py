@@ -260,3 +260,37 @@ def test_find_model_dirs_errors(tmp_path: Path) -> None:
         find_model_dirs(tmp_path / "nowhere", ["one"])
     with pytest.raises(RunDirectoryError, match="model_one/ or model_two/"):
         find_model_dirs(tmp_path, ["one", "two"])
+
+
+# ------------------------------------------------------------------- Figure 6 over time
+
+
+def test_snapshot_panels_draw_first_and_last_snapshot_on_one_scale(
+        tmp_path: Path, write_synthetic_run: Callable[..., Any]) -> None:
+    import matplotlib.image as mpimg
+
+    from drumflow.report.paper import PARTICLES_TIMES, render_snapshot_panels
+    from drumflow.rundir import RunDir
+
+    root = write_synthetic_run(tmp_path / "run")
+    run = RunDir.existing(root)
+    case = load_case(run.case_toml)
+    # A second, colder snapshot at step 0 (the synthetic run writes only its last one).
+    last = next(run.dem_dumps.glob("snap.*.txt"))
+    text = last.read_text().splitlines()
+    header, rows = text[:9], text[9:]
+    header[1] = "0"
+    colder = [" ".join([*r.split()[:8], f"{float(r.split()[8]) - 30.0:.6g}"]) for r in rows]
+    (run.dem_dumps / "snap.0.txt").write_text("\n".join([*header, *colder]) + "\n")
+
+    target = render_snapshot_panels(run, case, tmp_path / PARTICLES_TIMES)
+    image = mpimg.imread(target)[..., :3]
+    height, width = image.shape[:2]
+    # Two panels side by side (wider than tall) with particles drawn: a blank or single-panel
+    # figure would fail one of these.
+    assert width > 1.5 * height
+    assert (image.sum(axis=2) < 2.7).mean() > 0.01
+
+    empty = RunDir.existing(write_synthetic_run(tmp_path / "bare", extras=False))
+    with pytest.raises(RunDirectoryError, match="no particle snapshot"):
+        render_snapshot_panels(empty, case, tmp_path / "none.png")
