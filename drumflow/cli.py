@@ -455,6 +455,52 @@ def bench(
         raise typer.Exit(1)
 
 
+@app.command()
+def profile(
+    run_dir: Annotated[Path, typer.Argument(help="run directory written by `drumflow run`")],
+    window: Annotated[
+        float, typer.Option("--window", min=1e-6, help="summary window, simulated seconds")
+    ] = 0.5,
+    out: Annotated[
+        Path | None, typer.Option("--out", "-o", help="folder for profile.csv and profile.png "
+                                  "(default: RUN_DIR/post)")
+    ] = None,
+    as_json: Annotated[bool, typer.Option("--json", help="print the windows as JSON")] = False,
+) -> None:
+    """Where the time goes: LIGGGHTS' timing breakdowns and the coupling loop's wall times."""
+    from drumflow.bench.profile import profile_run, write_profile
+    from drumflow.rundir import RunDir
+
+    result = profile_run(run_dir, window_s=window)
+    folder = out or RunDir.existing(run_dir).post
+    paths = write_profile(result, folder, title=f"{run_dir.name}: where the time goes")
+    if as_json:
+        console.print_json(json.dumps({"windows": json.loads(result.windows.to_json(orient="records")),
+                                       "files": {k: str(v) for k, v in paths.items()}}))
+        return
+    # Comm without the fixes' own communication, which LIGGGHTS also counts in the fixes.
+    table = Table(title=f"{run_dir.name}: where the time goes, per {window:g} s simulated "
+                  "(% of LIGGGHTS' loop in sampled intervals; comm outside the fixes)")
+    cols = [("window (s)", None, ""), ("steps", "steps", "{:,.0f}"), ("pair", "pair_pct", "{:.1f}"),
+            ("neigh", "neigh_pct", "{:.1f}"), ("walls", "walls_pct", "{:.1f}"),
+            ("conduction", "conduction_pct", "{:.1f}"), ("air drag", "air_drag_pct", "{:.1f}"),
+            ("comm", "comm_outside_fixes_pct", "{:.1f}"), ("output", "output_pct", "{:.1f}"),
+            ("other", "other_net_pct", "{:.1f}"), ("neighs/atom", "neighs_per_atom", "{:.2f}"),
+            ("builds/1000", "neighbor_builds_per_1000_steps", "{:.1f}"),
+            ("Python %", "python_share", "{:.1%}"), ("particle-steps/s", "particle_steps_per_s", "{:,.0f}")]
+    for title, _, _ in cols:
+        table.add_column(title, justify="left" if title.startswith("window") else "right")
+    for _, w in result.windows.iterrows():
+        cells = [f"{w['window_start_s']:g}-{w['window_end_s']:g}"]
+        for _, key, fmt in cols[1:]:
+            value = w.get(key)
+            cells.append("-" if value is None or value != value else fmt.format(value))
+        table.add_row(*cells)
+    console.print(table)
+    console.print(f"{len(result.intervals)} sampled intervals; written: "
+                  + ", ".join(str(p) for p in paths.values()), highlight=False)
+
+
 # Last, after every command (and the groups above) is registered: one wrapper for all.
 guard_every_command(app)
 

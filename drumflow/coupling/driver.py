@@ -16,6 +16,12 @@ rank only needs its local particles. Each rank writes its own coupling log; post
 adds them up.
 
 One-way coupling as in the paper: the air keeps its field and its inlet temperature.
+
+Profile: every coupling-log row ends with the wall seconds this rank spent in Python (air
+sampling, drag, heat, crossings, stop rule) and in LIGGGHTS' ``run`` for that interval. About
+every :data:`PROFILE_EVERY_STEPS` DEM steps, and at the last interval, the run ends with ``post
+yes``: LIGGGHTS then prints its timing breakdown (pair, neighbour, communication, output, fixes
+one by one under ``modify_timing on``) into its log, which :mod:`drumflow.bench.profile` reads.
 """
 
 from __future__ import annotations
@@ -24,6 +30,7 @@ import ctypes as C
 import json
 import os
 import sys
+import time
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Protocol
@@ -38,6 +45,13 @@ from drumflow.coupling.stop import StopMonitor
 
 #: Per-atom properties the deck defines for the drag (``fix addforce`` reads them).
 DRAG_FIXES = ("air_fx", "air_fy", "air_fz")
+#: The coupling log's columns. The wall times come last, so readers by name of older logs
+#: (without them) and of new ones read the same physics columns.
+LOG_COLUMNS = ("step", "time_s", "steps", "heat_to_particles_W", "drag_x_N", "drag_y_N", "drag_z_N",
+               "particles", "mean_slip_m_s", "python_wall_s", "liggghts_wall_s")
+#: DEM steps between LIGGGHTS timing breakdowns (``run ... post yes``), roughly; the spec's
+#: ``profile_every_steps`` overrides it.
+PROFILE_EVERY_STEPS = 200
 
 
 class VelocityField(Protocol):
@@ -102,6 +116,12 @@ def _finalize_mpi() -> None:
         pass
 
 
+def profile_stride(interval: int, every_steps: int = PROFILE_EVERY_STEPS) -> int:
+    """Coupling intervals between two timing breakdowns: the whole number of intervals closest to
+    ``every_steps`` DEM steps, at least one."""
+    return max(1, round(every_steps / max(interval, 1)))
+
+
 def run(spec_path: Path) -> int:
     """Run the coupled loop described by a JSON spec (written by
     :meth:`drumflow.coupling.spec.CouplingSpec.write_driver_file`)."""
@@ -115,8 +135,13 @@ def run(spec_path: Path) -> int:
     dt = float(spec["time_step"])
     total = int(spec["total_steps"])
     interval = int(spec["interval"])
+    stride = profile_stride(interval, int(spec.get("profile_every_steps", PROFILE_EVERY_STEPS)))
     lmp = Liggghts(["-log", spec["log"], "-echo", "none"])
     lmp.file(Path(spec["deck"]))
+    # Time every fix on its own, so the breakdown splits LIGGGHTS' "Modify" share into walls,
+    # conduction, air drag and integration (a clock read around each fix call: negligible
+    # against a time step of a bed).
+    lmp.command("modify_timing on")
     step = int(C.cast(lmp._lib.lammps_extract_global(lmp._handle, b"ntimestep"), C.POINTER(C.c_int64))[0])
     start = step
     log_path = Path(spec["coupling_log"].format(rank=rank, start=start))
@@ -133,9 +158,11 @@ def run(spec_path: Path) -> int:
     tracker = (CrossingTracker(int(spec["particles"]), work, rank, record_crossings, start * dt)
                if monitor is not None or record_crossings else None)
     stopped = False
+    updates = 0
     with log_path.open("w") as out:
-        out.write("step,time_s,steps,heat_to_particles_W,drag_x_N,drag_y_N,drag_z_N,particles,mean_slip_m_s\n")
+        out.write(",".join(LOG_COLUMNS) + "\n")
         while step < total:
+            started = time.perf_counter()
             n = min(interval, total - step)
             x = lmp.atom_array("x")
             v = lmp.atom_array("v")
@@ -156,15 +183,23 @@ def run(spec_path: Path) -> int:
             lmp.fix_vector("heatSource")[:] = heat
             slip = float(np.linalg.norm(u - v, axis=1).mean()) if len(v) else 0.0
             row = (step, step * dt, n, float(heat.sum()), *map(float, force.sum(axis=0)), len(v), slip)
-            out.write(",".join(f"{c:.12g}" for c in row) + "\n")
-            # Flush every row: an interrupted run is resumed from a restart file, and the heat
-            # applied before that restart must survive a SIGTERM (which ends Python without
-            # flushing its buffers), or the resumed energy balance misses it.
+            python_wall = time.perf_counter() - started
+            # The row without its last column, flushed before the run: an interrupted run is
+            # resumed from a restart file, and the heat applied before that restart must survive
+            # a SIGTERM (which ends Python without flushing its buffers), or the resumed energy
+            # balance misses it. A row cut there lacks only LIGGGHTS' wall time (read as NaN).
+            out.write(",".join(f"{c:.12g}" for c in (*row, python_wall)))
             out.flush()
             rows.append(row)
+            updates += 1
             # `pre no`: nothing but per-atom values changed since the last run, so LIGGGHTS
             # need not rebuild neighbour lists or re-initialise the fixes (the loop's cost).
-            lmp.command(f"run {n} pre no post no")
+            # `post yes` every `stride` updates and at the end: the timing breakdown.
+            post = "yes" if updates % stride == 0 or step + n >= total else "no"
+            ran = time.perf_counter()
+            lmp.command(f"run {n} pre no post {post}")
+            out.write(f",{time.perf_counter() - ran:.6g}\n")
+            out.flush()
             step += n
     if tracker is not None:
         if not stopped:

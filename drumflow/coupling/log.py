@@ -9,6 +9,10 @@ import numpy as np
 import pandas as pd
 
 _NAME = re.compile(r"rank(\d+)\.(\d+)\.csv$")
+#: Wall seconds of each update in Python and in LIGGGHTS' run (logs written since the loop
+#: profiles itself; older logs lack them). The ranks run in lockstep, so an update takes as
+#: long as its slowest rank: the maximum over ranks.
+WALL_COLUMNS = ("python_wall_s", "liggghts_wall_s")
 
 
 def read_coupling(folder: Path, time_step: float) -> pd.DataFrame:
@@ -22,7 +26,9 @@ def read_coupling(folder: Path, time_step: float) -> pd.DataFrame:
     pandas.DataFrame
         Columns ``step, time_s, steps, heat_to_particles_W, drag_x_N, drag_y_N, drag_z_N,
         particles, heat_removed_J`` (cumulative heat taken from the particles), sorted by step;
-        empty when the run had no air.
+        empty when the run had no air. Logs that record wall times add ``python_wall_s,
+        liggghts_wall_s`` last (the slowest rank's wall seconds of the update; NaN for an update
+        of an older attempt without them, or one cut by an interrupt).
     """
     attempts: dict[int, list[pd.DataFrame]] = {}
     for path in folder.glob("rank*.csv"):
@@ -38,6 +44,7 @@ def read_coupling(folder: Path, time_step: float) -> pd.DataFrame:
     kept = []
     for i, start in enumerate(starts):
         frame = pd.concat(attempts[start], ignore_index=True)
+        walls = {name: (name, "max") for name in WALL_COLUMNS if name in frame.columns}
         summed = frame.groupby("step", as_index=False).agg(
             steps=("steps", "first"),
             heat_to_particles_W=("heat_to_particles_W", "sum"),
@@ -45,6 +52,7 @@ def read_coupling(folder: Path, time_step: float) -> pd.DataFrame:
             drag_y_N=("drag_y_N", "sum"),
             drag_z_N=("drag_z_N", "sum"),
             particles=("particles", "sum"),
+            **walls,
         )
         end = starts[i + 1] if i + 1 < len(starts) else np.inf
         kept.append(summed[summed["step"] < end])
@@ -52,4 +60,8 @@ def read_coupling(folder: Path, time_step: float) -> pd.DataFrame:
     table.insert(1, "time_s", table["step"] * time_step)
     # The heat is held constant over `steps` DEM steps: LIGGGHTS adds it at each of them.
     table["heat_removed_J"] = np.cumsum(-table["heat_to_particles_W"] * table["steps"] * time_step)
-    return table
+    present = [name for name in WALL_COLUMNS if name in table.columns]
+    if not present:
+        return table
+    # The wall times after the physics, as in the logs (NaN for an attempt that predates them).
+    return table[[c for c in table.columns if c not in present] + present]

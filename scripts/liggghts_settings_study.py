@@ -1,0 +1,359 @@
+"""LIGGGHTS settings side by side, from one restart of a coupled run (drumflow issue 11, lever 4).
+
+How to use::
+
+    .venv/bin/python scripts/liggghts_settings_study.py RUN_DIR [--steps 400] [--np 2]
+        [--out runs/settings_study/RUN/settings.csv] [--scratch DIR] [--restart STEP]
+        [--only baseline,skin_x2] [--timeout 3600]
+
+Every variant (:data:`VARIANTS`, the one list of what is compared) starts from the same restart
+file of RUN_DIR (the newest ``dem/restart/drum.STEP.restart`` unless ``--restart``), runs
+``--steps`` DEM steps through the real coupling loop (``python -m drumflow.coupling.driver``
+under mpirun, through :class:`drumflow.runner.Runner`: drag and heat included, a timing
+breakdown after every coupling interval) in its own folder under the scratch directory, and is
+read back with :func:`drumflow.bench.profile.profile_run`. Written: the CSV (one row per
+variant: status, loop and wall seconds, steps/s, particle-steps/s, the breakdown, speed-up
+over the baseline, and the physics check) and a JSON beside it with the variants, the
+tolerances and the machine.
+
+The deck is RUN_DIR/dem/in.drum.resume when the run was resumed, else one rendered the way the
+DEM stage renders resume decks (:func:`drumflow.dem.stage._write_deck`). The baseline uses the
+default processor grid for ``--np`` (:func:`drumflow.dem.deck.processors_grid`).
+
+Physics check: after the steps, the mass-weighted mean temperature and the kinetic energy must
+match the baseline's within noise. A changed neighbour list or atom order changes round-off,
+which a granular bed amplifies, but not the physics: the temperatures are held to
+:data:`TEMPERATURE_TOLERANCE` of the baseline's own temperature change over the steps (plus
+:data:`TEMPERATURE_FLOOR_K`) and the kinetic energy to :data:`KINETIC_ENERGY_TOLERANCE`. A
+variant that misses contacts (a skin too small for its rebuild rule) changes both by far more,
+and LIGGGHTS counts its "dangerous builds", which the CSV also shows.
+
+Timings are only comparable on an otherwise idle machine.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import re
+import shutil
+import sys
+import time
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Any
+
+import pandas as pd
+
+from drumflow.bench.profile import profile_run
+from drumflow.case import load_case
+from drumflow.coupling.spec import COUPLING_FILE, CouplingSpec, driver_command
+from drumflow.dem.deck import processors_grid
+from drumflow.dem.stage import DemInputs, _finished_loop, _latest_restart, _write_deck
+from drumflow.dem.thermo import read_thermo
+from drumflow.errors import DrumflowError
+from drumflow.geometry.stage import GeometryResult
+from drumflow.report.paper import _cpu_model
+from drumflow.rundir import RunDir
+from drumflow.runner import Runner
+
+
+@dataclass(frozen=True)
+class Variant:
+    """One set of LIGGGHTS settings, as changes to the baseline deck (LIGGGHTS 3.8 syntax).
+
+    Attributes
+    ----------
+    name, description
+        For the table.
+    skin_factor
+        The ``neighbor`` skin times this.
+    neigh_modify
+        Replaces the arguments of the deck's ``neigh_modify`` line.
+    atom_modify
+        An ``atom_modify`` line after ``read_restart`` (``sort`` may change at any time).
+    processors
+        Replaces the ``processors`` grid (``{np}`` is the rank count); ``processors`` must come
+        before the box is defined, i.e. before ``read_restart``, where the deck has it.
+    min_ranks
+        Skipped with fewer MPI ranks.
+    """
+
+    name: str
+    description: str
+    skin_factor: float = 1.0
+    neigh_modify: str | None = None
+    atom_modify: str | None = None
+    processors: str | None = None
+    min_ranks: int = 1
+
+
+#: What is compared. The deck's own settings are the baseline: ``neighbor SKIN bin`` (half a
+#: particle diameter unless the case sets it), ``neigh_modify delay 0`` (LIGGGHTS' every 1 check
+#: yes), LIGGGHTS' default sort (``atom_modify sort 1000 0.0``: every 1000 steps, bins of half
+#: the neighbour cutoff) and the default processor grid for the rank count.
+VARIANTS: list[Variant] = [
+    Variant("baseline", "the run's deck, default processor grid for --np"),
+    Variant("skin_x0.5", "neighbour skin halved (shorter lists, more rebuilds)", skin_factor=0.5),
+    Variant("skin_x2", "neighbour skin doubled (longer lists, fewer rebuilds)", skin_factor=2.0),
+    Variant("neigh_every5_check", "check for a rebuild every 5 steps only",
+            neigh_modify="delay 0 every 5 check yes"),
+    Variant("neigh_every1_nocheck", "rebuild at every step (upper bound of the list cost)",
+            neigh_modify="delay 0 every 1 check no"),
+    Variant("sort_off", "no spatial sorting of atoms", atom_modify="sort 0 0.0"),
+    Variant("sort_every100", "spatial sort every 100 steps (default bins)", atom_modify="sort 100 0.0"),
+    Variant("grid_axis", "processor grid along the drum axis (z)", processors="1 1 {np}", min_ranks=2),
+    Variant("grid_x", "processor grid across the drum, along x", processors="{np} 1 1", min_ranks=2),
+    Variant("grid_y", "processor grid across the drum, along y (gravity)", processors="1 {np} 1",
+            min_ranks=2),
+]
+
+#: Mean temperature after the steps: within this fraction of the baseline's change over them...
+TEMPERATURE_TOLERANCE = 0.02
+#: ...plus this, K (the thermo output has 12 digits, ~1e-10 K at 100 °C).
+TEMPERATURE_FLOOR_K = 1e-6
+#: Kinetic energy after the steps, relative to the baseline's.
+KINETIC_ENERGY_TOLERANCE = 0.05
+RESTART_INPUT = "input"
+
+
+class StudyError(DrumflowError, ValueError):
+    """The run directory cannot be studied (no restart, not coupled, a deck of another form)."""
+
+
+def _replace_line(deck: str, pattern: str, line: str) -> str:
+    new, count = re.subn(pattern, line, deck, flags=re.M)
+    if count != 1:
+        raise StudyError(f"deck: expected one line matching {pattern!r}, found {count}")
+    return new
+
+
+def apply_variant(deck: str, variant: Variant, ranks: int) -> str:
+    """The baseline deck with the variant's settings."""
+    if variant.skin_factor != 1.0:
+        m = re.search(r"^neighbor\s+(\S+)\s+bin\s*$", deck, flags=re.M)
+        if m is None:
+            raise StudyError("deck: no `neighbor SKIN bin` line")
+        skin = float(m.group(1)) * variant.skin_factor
+        deck = _replace_line(deck, r"^neighbor\s+.*$", f"neighbor        {skin:.6g} bin")
+    if variant.neigh_modify is not None:
+        deck = _replace_line(deck, r"^neigh_modify\s+.*$", f"neigh_modify    {variant.neigh_modify}")
+    if variant.atom_modify is not None:
+        m = re.search(r"^read_restart\s+.*$", deck, flags=re.M)
+        if m is None:
+            raise StudyError("deck: no read_restart line")
+        deck = deck[:m.end()] + f"\natom_modify     {variant.atom_modify}" + deck[m.end():]
+    if variant.processors is not None:
+        deck = _replace_line(deck, r"^processors\s+.*$",
+                             f"processors      {variant.processors.format(np=ranks)}")
+    return deck
+
+
+def _restart(rundir: RunDir, step: int | None) -> tuple[Path, int]:
+    if step is None:
+        newest = _latest_restart(rundir.dem_restart)
+        if newest is None:
+            raise StudyError(f"{rundir.dem_restart}: no drum.STEP.restart file")
+        return newest
+    path = rundir.dem_restart / f"drum.{step}.restart"
+    if not path.is_file():
+        raise StudyError(f"{path}: no such restart file")
+    return path, step
+
+
+def baseline_deck(rundir: RunDir, restart_step: int, ranks: int, scratch: Path,
+                  driver: dict[str, Any]) -> tuple[str, str]:
+    """The deck every variant starts from, reading ``input/drum.STEP.restart``, on the default
+    processor grid for ``ranks``; and where it came from."""
+    case = load_case(rundir.case_toml)
+    restart = f"{RESTART_INPUT}/drum.{restart_step}.restart"
+    resume_deck = rundir.dem / "in.drum.resume"
+    if resume_deck.is_file():
+        deck = _replace_line(resume_deck.read_text(), r"^read_restart\s+.*$",
+                             f"read_restart    {restart}")
+        deck = _replace_line(deck, r"^processors\s+.*$", f"processors      {processors_grid(case, ranks)}")
+        return deck, str(resume_deck)
+    # Rendered as the DEM stage renders a resume deck, in a scratch run directory.
+    data = json.loads(rundir.geometry_json.read_text())
+    geometry = GeometryResult(**{**data, "box_lo": tuple(data["box_lo"]), "box_hi": tuple(data["box_hi"])})
+    coupling = CouplingSpec(field=driver["field"], field_key="", interval=int(driver["interval"]),
+                            temperature_C=float(driver["air_temperature_C"]),
+                            pressure_kPa=float(driver["air_pressure_kPa"]), omega=float(driver["omega"]))
+    inputs = DemInputs.for_case(case, geometry, coupling=coupling, processes=ranks)
+    source = RunDir(scratch / "_deck")
+    source.dem.mkdir(parents=True, exist_ok=True)
+    fake_restart = source.dem / restart  # only its name goes into the deck
+    deck_name, _ = _write_deck(case, source, inputs, (fake_restart, restart_step))
+    return (source.dem / deck_name).read_text(), "rendered from the case (drumflow.dem.stage._write_deck)"
+
+
+def _prepare(folder: Path, rundir: RunDir, restart: Path, deck: str, driver: dict[str, Any],
+             end_step: int) -> None:
+    """A run-directory-like folder: case, geometry, the deck, the restart (linked, read only)
+    and the coupling loop's input for ``end_step``."""
+    if folder.exists():
+        shutil.rmtree(folder)
+    dem = folder / "dem"
+    for sub in ("dumps", "restart", "coupling", RESTART_INPUT):
+        (dem / sub).mkdir(parents=True)
+    shutil.copy2(rundir.case_toml, folder / "case.toml")
+    shutil.copytree(rundir.geometry, folder / "geometry")
+    # Linked under input/, never under restart/: LIGGGHTS writes its own restarts there.
+    (dem / RESTART_INPUT / restart.name).symlink_to(restart.resolve())
+    (dem / "in.drum.resume").write_text(deck)
+    spec = {k: v for k, v in driver.items() if k != "stop"}  # exactly --steps steps
+    spec.update(deck="in.drum.resume", log="log.liggghts", total_steps=end_step, tail=[],
+                profile_every_steps=1)  # a breakdown after every coupling interval
+    (dem / COUPLING_FILE).write_text(json.dumps(spec, indent=2))
+
+
+def _measure(folder: Path, steps: int) -> dict[str, Any]:
+    """Timings, breakdown and end state of a finished variant."""
+    profile = profile_run(folder, window_s=math.inf)
+    window = profile.windows.iloc[0]
+    loops = profile.loops
+    thermo = read_thermo(folder / "dem")
+    first, last = thermo.iloc[0], thermo.iloc[-1]
+    atoms = int(loops["atoms"].iloc[-1])
+    row: dict[str, Any] = {
+        "steps": int(last["step"] - first["step"]),
+        "atoms": atoms,
+        "loop_s": float(loops["loop_s"].sum()),
+        "python_wall_s": float(profile.intervals["python_wall_s"].sum()),
+        "liggghts_wall_s": float(profile.intervals["liggghts_wall_s"].sum()),
+    }
+    coupled = row["python_wall_s"] + row["liggghts_wall_s"]
+    row["coupled_wall_s"] = coupled
+    row["steps_per_s"] = steps / coupled if coupled > 0 else math.nan
+    row["particle_steps_per_s"] = atoms * steps / coupled if coupled > 0 else math.nan
+    row["liggghts_particle_steps_per_s"] = float(window["liggghts_particle_steps_per_s"])
+    for key in ("pair_pct", "neigh_pct", "comm_pct", "comm_outside_fixes_pct", "output_pct", "modify_pct",
+                "other_pct", "walls_pct", "conduction_pct", "air_drag_pct", "integration_pct",
+                "other_fixes_pct", "neighs_per_atom", "neighbor_builds_per_1000_steps",
+                "dangerous_builds", "python_share"):
+        row[key] = float(window[key])
+    row.update(T_start_C=float(first["T_mean"]), T_end_C=float(last["T_mean"]),
+               kinetic_energy_J=float(last["ke"]))
+    return row
+
+
+def physics_check(row: dict[str, Any], base: dict[str, Any]) -> dict[str, Any]:
+    """The variant's end state against the baseline's (module docstring)."""
+    change = abs(base["T_end_C"] - base["T_start_C"])
+    t_tol = TEMPERATURE_TOLERANCE * change + TEMPERATURE_FLOOR_K
+    t_err = abs(row["T_end_C"] - base["T_end_C"])
+    ke_err = abs(row["kinetic_energy_J"] - base["kinetic_energy_J"]) / abs(base["kinetic_energy_J"])
+    return {"T_difference_K": t_err, "T_tolerance_K": t_tol, "ke_relative_difference": ke_err,
+            "ke_tolerance": KINETIC_ENERGY_TOLERANCE,
+            "physics_ok": bool(t_err <= t_tol and ke_err <= KINETIC_ENERGY_TOLERANCE)}
+
+
+def machine_info(runner: Runner, ranks: int) -> dict[str, Any]:
+    versions = runner.profile.software_versions()
+    return {"platform": versions["platform"], "cpu": _cpu_model(), "cpus": runner.profile.cores,
+            "ranks": ranks, "liggghts": versions["liggghts"], "openmpi": versions["openmpi"],
+            "python": versions["python"]}
+
+
+def run_study(run_dir: Path, steps: int, ranks: int, out: Path, scratch: Path,
+              restart_step: int | None = None, only: list[str] | None = None,
+              timeout: float = 3600.0) -> pd.DataFrame:
+    """Run the variants one after the other; write ``out`` (CSV) and its JSON; return the table."""
+    rundir = RunDir.existing(run_dir)
+    driver_path = rundir.dem / COUPLING_FILE
+    if not driver_path.is_file():
+        raise StudyError(f"{driver_path}: missing; the study runs the coupling loop, so RUN_DIR "
+                         "must be a run with air")
+    driver = json.loads(driver_path.read_text())
+    restart, start = _restart(rundir, restart_step)
+    scratch.mkdir(parents=True, exist_ok=True)
+    deck, deck_source = baseline_deck(rundir, start, ranks, scratch, driver)
+    variants = [v for v in VARIANTS if only is None or v.name in only]
+    if not variants or variants[0].name != "baseline":
+        raise StudyError("the baseline must run (first): it is the physics check's reference")
+    runner = Runner()
+    rows: list[dict[str, Any]] = []
+    base: dict[str, Any] | None = None
+    baseline_grid = processors_grid(load_case(rundir.case_toml), ranks)
+    for variant in variants:
+        row: dict[str, Any] = {"variant": variant.name, "description": variant.description}
+        grid = variant.processors.format(np=ranks) if variant.processors else None
+        if ranks < variant.min_ranks:
+            rows.append({**row, "status": f"skipped: needs {variant.min_ranks} MPI ranks"})
+            continue
+        if grid is not None and grid == baseline_grid:
+            rows.append({**row, "status": f"skipped: the baseline's grid ({grid})"})
+            continue
+        folder = scratch / variant.name
+        _prepare(folder, rundir, restart, apply_variant(deck, variant, ranks), driver, start + steps)
+        sys.stderr.write(f"{variant.name}: {steps} steps from step {start} on {ranks} rank(s)...\n")
+        t0 = time.perf_counter()
+        try:
+            record = runner.run("liggghts", driver_command(runner.profile, ranks, COUPLING_FILE),
+                                folder / "dem", folder / "dem" / "liggghts.out", timeout=timeout,
+                                check=_finished_loop, follow=folder / "dem" / "log.liggghts")
+        except DrumflowError as exc:
+            if base is None:
+                raise
+            rows.append({**row, "status": f"failed: {exc}"[:300]})
+            continue
+        row.update(status="ok", wall_s=record.wall_time_s or time.perf_counter() - t0,
+                   **_measure(folder, steps))
+        if base is None:
+            base = row
+        row.update(physics_check(row, base))
+        row["speedup_vs_baseline"] = base["coupled_wall_s"] / row["coupled_wall_s"]
+        rows.append(row)
+        sys.stderr.write(f"  {row['particle_steps_per_s']:,.0f} particle-steps/s, physics "
+                         f"{'ok' if row['physics_ok'] else 'CHANGED'}\n")
+    table = pd.DataFrame(rows)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    table.to_csv(out, index=False, float_format="%.6g")
+    meta = {"run_dir": str(rundir.root), "restart": str(restart), "restart_step": start, "steps": steps,
+            "ranks": ranks, "deck": deck_source, "scratch": str(scratch.resolve()),
+            "variants": [asdict(v) for v in variants],
+            "tolerances": {"temperature_of_change": TEMPERATURE_TOLERANCE,
+                           "temperature_floor_K": TEMPERATURE_FLOOR_K,
+                           "kinetic_energy_relative": KINETIC_ENERGY_TOLERANCE},
+            "machine": machine_info(runner, ranks),
+            "results": json.loads(table.to_json(orient="records"))}
+    out.with_suffix(".json").write_text(json.dumps(meta, indent=2))
+    return table
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("run_dir", type=Path, help="run directory of a coupled run with restart files")
+    parser.add_argument("--steps", type=int, default=400, help="DEM steps per variant (default 400)")
+    parser.add_argument("--np", dest="ranks", type=int, default=2, help="MPI ranks (default 2)")
+    parser.add_argument("--out", type=Path, default=None,
+                        help="CSV to write (default runs/settings_study/RUN/settings.csv); JSON beside it")
+    parser.add_argument("--scratch", type=Path, default=None,
+                        help="folder for the variants' runs (default: beside --out, variants/)")
+    parser.add_argument("--restart", type=int, default=None, help="restart step (default: the newest)")
+    parser.add_argument("--only", default=None, help="comma-separated variant names (baseline first)")
+    parser.add_argument("--timeout", type=float, default=3600.0, help="time limit per variant, s")
+    args = parser.parse_args(argv)
+    if args.steps < 1 or args.ranks < 1:
+        parser.error("--steps and --np must be at least 1")
+    out = args.out or Path("runs") / "settings_study" / args.run_dir.resolve().name / "settings.csv"
+    scratch = args.scratch or out.parent / "variants"
+    only = [n.strip() for n in args.only.split(",")] if args.only else None
+    try:
+        table = run_study(args.run_dir, args.steps, args.ranks, out, scratch, args.restart, only,
+                          args.timeout)
+    except DrumflowError as exc:
+        sys.stderr.write(f"error: {exc}\n")
+        return 2 if isinstance(exc, ValueError) else 1
+    cols = ["variant", "status", "coupled_wall_s", "particle_steps_per_s", "speedup_vs_baseline",
+            "pair_pct", "neigh_pct", "walls_pct", "conduction_pct", "neighbor_builds_per_1000_steps",
+            "dangerous_builds", "physics_ok"]
+    with pd.option_context("display.width", 200, "display.max_columns", 20):
+        print(table.reindex(columns=cols).to_string(index=False))
+    print(f"written: {out}, {out.with_suffix('.json')}")
+    return 1 if table["status"].astype(str).str.startswith("failed").any() else 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

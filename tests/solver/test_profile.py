@@ -1,0 +1,112 @@
+"""The coupled loop's profile and the LIGGGHTS settings study on the real solver (tiny drum).
+
+One short coupled run of the tiny drum with plug-flow air (no OpenFOAM); then `drumflow profile`
+on it, and scripts/liggghts_settings_study.py from its restart on one rank.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import json
+import subprocess
+import sys
+from pathlib import Path
+from typing import Any
+
+import pandas as pd
+import pytest
+from support.solvers import LIGGGHTS, ROOT, requires_solver
+
+pytestmark = [pytest.mark.solver, pytest.mark.timeout(400), requires_solver(*LIGGGHTS)]
+
+STUDY = ROOT / "scripts" / "liggghts_settings_study.py"
+#: LIGGGHTS prints each time and percentage with %g (6 significant digits): a percentage below
+#: 100 is off by at most 5e-5, so six categories add up to 100 within 3e-4 (LIGGGHTS' Other is
+#: the loop time minus the rest, so before rounding they add up exactly). 1e-3 leaves room and
+#: still catches a category lost or counted twice.
+ROUNDING = 1e-3
+
+
+def _study_variants() -> list[Any]:
+    spec = importlib.util.spec_from_file_location("liggghts_settings_study", STUDY)
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module  # its dataclasses look their module up there
+    spec.loader.exec_module(module)
+    return list(module.VARIANTS)
+
+
+@pytest.fixture(scope="module")
+def run(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    from drumflow.pipeline import run_case
+    from drumflow.verify.scenes import tiny_drum
+
+    case = tiny_drum(air__model="uniform", air__mass_flow=0.1, run__time=0.2, run__mass_flow_start=0.1,
+                     run__restart_interval=0.1, run__processes=1)
+    out = tmp_path_factory.mktemp("profile") / "run"
+    run_case(case, out, timeout=300)
+    return out
+
+
+def test_profile_of_a_coupled_run(run: Path) -> None:
+    from drumflow.bench.profile import CATEGORIES, GROUPS, profile_run
+    from drumflow.coupling.log import read_coupling
+
+    dt = json.loads((run / "dem" / "coupling.json").read_text())["time_step"]
+    coupling = read_coupling(run / "dem" / "coupling", dt)
+    # Every update logged both wall times, and both are real time spent.
+    assert coupling["python_wall_s"].notna().all() and coupling["liggghts_wall_s"].notna().all()
+    assert (coupling["python_wall_s"] > 0).all() and (coupling["liggghts_wall_s"] > 0).all()
+
+    profile = profile_run(run)
+    table = profile.intervals
+    assert len(table) >= 1
+    # The last interval always prints its breakdown.
+    assert table["step"].max() == coupling["step"].max() + coupling["steps"].iloc[-1]
+    total = sum(table[f"{c}_pct"] for c in CATEGORIES)
+    assert (total - 100.0).abs().max() < ROUNDING
+    # Under modify_timing every fix is timed: the groups add up to LIGGGHTS' Modfy share.
+    groups = sum(table[f"{g}_pct"] for g in GROUPS)
+    assert (groups - table["modify_pct"]).abs().max() < ROUNDING
+    assert (table["python_wall_s"] + table["liggghts_wall_s"] > 0).all()
+    shares = table.filter(like="share_").sum(axis=1)
+    assert (shares - 1.0).abs().max() < 1e-3
+    assert (table["neighs_per_atom"] > 0).all() and (table["atoms"] == 500).all()
+    windows = profile.windows
+    assert windows["steps"].sum() == coupling["steps"].sum()
+    assert (windows["particle_steps_per_s"] > 0).all()
+
+    proc = subprocess.run([sys.executable, "-m", "drumflow.cli", "profile", str(run), "--window", "0.1"],
+                          capture_output=True, text=True, timeout=120, check=False)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    written = pd.read_csv(run / "post" / "profile_windows.csv")
+    assert len(written) == 2  # 0.2 s in windows of 0.1 s
+    assert (run / "post" / "profile.png").stat().st_size > 10_000
+    assert len(pd.read_csv(run / "post" / "profile.csv")) == len(table)
+
+
+def test_settings_study_from_the_restart(run: Path, tmp_path: Path) -> None:
+    out = tmp_path / "study" / "settings.csv"
+    proc = subprocess.run([sys.executable, str(STUDY), str(run), "--steps", "100", "--np", "1",
+                           "--out", str(out)], capture_output=True, text=True, timeout=350, check=False)
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    table = pd.read_csv(out).set_index("variant")
+    variants = _study_variants()
+    assert list(table.index) == [v.name for v in variants]
+    for v in variants:
+        row = table.loc[v.name]
+        if v.min_ranks > 1:
+            assert str(row["status"]).startswith("skipped"), v.name
+            continue
+        assert row["status"] == "ok", (v.name, row["status"])
+        assert row["steps"] == 100
+        assert row["particle_steps_per_s"] > 0
+        assert abs(sum(row[f"{c}_pct"] for c in ("pair", "neigh", "comm", "output", "modify", "other"))
+                   - 100.0) < ROUNDING
+        assert bool(row["physics_ok"]), (v.name, row["T_difference_K"], row["ke_relative_difference"])
+    # Each variant's setting reached LIGGGHTS' deck.
+    deck = (out.parent / "variants" / "skin_x2" / "dem" / "in.drum.resume").read_text()
+    base = (out.parent / "variants" / "baseline" / "dem" / "in.drum.resume").read_text()
+    assert deck != base and "neighbor        0.008 bin" in deck
+    meta = json.loads(out.with_suffix(".json").read_text())
+    assert meta["steps"] == 100 and meta["machine"]["cpus"] >= 1

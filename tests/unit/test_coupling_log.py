@@ -1,0 +1,58 @@
+"""The coupling loop's per-rank logs read back: old logs without wall times and new ones with them."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import pytest
+
+from drumflow.coupling.log import WALL_COLUMNS, read_coupling
+
+OLD_HEADER = "step,time_s,steps,heat_to_particles_W,drag_x_N,drag_y_N,drag_z_N,particles,mean_slip_m_s\n"
+NEW_HEADER = OLD_HEADER.rstrip("\n") + ",python_wall_s,liggghts_wall_s\n"
+DT = 1e-4
+
+
+def _row(step: int, heat: float, particles: int) -> str:
+    return f"{step},{step * DT},100,{heat},0.1,0,-0.2,{particles},2.5"
+
+
+def test_old_logs_read_as_before_without_wall_columns(tmp_path: Path) -> None:
+    (tmp_path / "rank0.0.csv").write_text(OLD_HEADER + _row(0, -2.0, 3) + "\n" + _row(100, -1.0, 3) + "\n")
+    (tmp_path / "rank1.0.csv").write_text(OLD_HEADER + _row(0, -4.0, 2) + "\n" + _row(100, -3.0, 2) + "\n")
+    table = read_coupling(tmp_path, DT)
+    assert list(table.columns) == ["step", "time_s", "steps", "heat_to_particles_W", "drag_x_N", "drag_y_N",
+                                   "drag_z_N", "particles", "heat_removed_J"]
+    assert table["heat_to_particles_W"].tolist() == [-6.0, -4.0]
+    assert table["particles"].tolist() == [5, 5]
+    assert table["heat_removed_J"].iloc[-1] == pytest.approx((6.0 + 4.0) * 100 * DT)
+
+
+def test_new_logs_carry_the_slowest_rank_wall_times_last(tmp_path: Path) -> None:
+    # Rank 0 is slower in Python at step 0, rank 1 in LIGGGHTS; the last row of each rank was cut
+    # by an interrupt during LIGGGHTS' run (no newline, no LIGGGHTS time).
+    (tmp_path / "rank0.0.csv").write_text(
+        NEW_HEADER + _row(0, -2.0, 3) + ",0.5,1.0\n" + _row(100, -1.0, 3) + ",0.25")
+    (tmp_path / "rank1.0.csv").write_text(
+        NEW_HEADER + _row(0, -4.0, 2) + ",0.1,2.0\n" + _row(100, -3.0, 2) + ",0.75")
+    table = read_coupling(tmp_path, DT)
+    assert list(table.columns[-2:]) == list(WALL_COLUMNS)
+    assert table["heat_to_particles_W"].tolist() == [-6.0, -4.0]
+    assert table["python_wall_s"].tolist() == [0.5, 0.75]
+    assert table["liggghts_wall_s"].iloc[0] == 2.0
+    assert math.isnan(table["liggghts_wall_s"].iloc[1])
+
+
+def test_a_resume_with_wall_times_after_an_old_attempt(tmp_path: Path) -> None:
+    # The old attempt logged steps 0-200 before it was killed; the resume from step 100 has
+    # wall times and supersedes its rows from step 100 on.
+    (tmp_path / "rank0.0.csv").write_text(
+        OLD_HEADER + "".join(_row(s, -1.0, 5) + "\n" for s in (0, 100, 200)))
+    (tmp_path / "rank0.100.csv").write_text(
+        NEW_HEADER + "".join(_row(s, -2.0, 5) + ",0.1,0.9\n" for s in (100, 200)))
+    table = read_coupling(tmp_path, DT)
+    assert table["step"].tolist() == [0, 100, 200]
+    assert table["heat_to_particles_W"].tolist() == [-1.0, -2.0, -2.0]
+    assert math.isnan(table["python_wall_s"].iloc[0])
+    assert table["liggghts_wall_s"].iloc[1:].tolist() == [0.9, 0.9]
