@@ -26,7 +26,7 @@ from drumflow.analysis.observables import (
 )
 from drumflow.case import Case, case_to_toml, load_case
 from drumflow.coupling.crossings import CROSSINGS_RECORD, read_loop_crossings
-from drumflow.coupling.log import read_coupling
+from drumflow.coupling.log import heat_removed_until, read_coupling
 from drumflow.coupling.spec import CouplingSpec, build_coupling
 from drumflow.coupling.stop import STOP_RECORD
 from drumflow.dem.dumps import read_rows, read_series
@@ -275,7 +275,8 @@ def _post_air(
     if coupling.empty:
         return {}
     coupling.to_csv(rundir.air_heat_csv, index=False, float_format="%.10g")
-    removed = float(coupling["heat_removed_J"].iloc[-1])
+    # Up to the last temperature output (a run stopped part way logged one more update).
+    removed = heat_removed_until(coupling, float(times[-1]), time_step)
     # The particles' enthalpy loss, from LIGGGHTS' mass-weighted mean temperature: an
     # independent route to the same number (conduction only moves heat between particles).
     loss = case.particle_mass_total * case.particles.heat_capacity * float(T_mean[0] - T_mean[-1])

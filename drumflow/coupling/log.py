@@ -65,3 +65,27 @@ def read_coupling(folder: Path, time_step: float) -> pd.DataFrame:
         return table
     # The wall times after the physics, as in the logs (NaN for an attempt that predates them).
     return table[[c for c in table.columns if c not in present] + present]
+
+
+def heat_removed_until(coupling: pd.DataFrame, t_end: float, time_step: float) -> float:
+    """Heat the air took from the particles from the start to ``t_end`` (J).
+
+    Each update's heat is held over its ``steps`` DEM steps; an update that reaches past
+    ``t_end`` counts only up to it. The loop logs an update before LIGGGHTS runs its steps, so
+    a run stopped part way (an interrupt, a time limit) has logged heat it never applied: the
+    particles' temperatures end at the last output, and so must the heat they are checked
+    against.
+
+    Parameters
+    ----------
+    coupling
+        :func:`read_coupling`'s table (``time_s``, ``steps``, ``heat_to_particles_W``).
+    t_end
+        The time of the last temperature output, s.
+    time_step
+        DEM time step, s.
+    """
+    start = coupling["time_s"].to_numpy(float)
+    held = coupling["steps"].to_numpy(float) * time_step
+    applied = np.clip(t_end - start, 0.0, held)
+    return float(np.sum(-coupling["heat_to_particles_W"].to_numpy(float) * applied))

@@ -56,3 +56,22 @@ def test_a_resume_with_wall_times_after_an_old_attempt(tmp_path: Path) -> None:
     assert table["heat_to_particles_W"].tolist() == [-1.0, -2.0, -2.0]
     assert math.isnan(table["python_wall_s"].iloc[0])
     assert table["liggghts_wall_s"].iloc[1:].tolist() == [0.9, 0.9]
+
+
+def test_heat_counts_only_up_to_the_last_temperature_output() -> None:
+    # Regression: post on an interrupted paper run (model two stopped at 3.52 s) found a 0.28 %
+    # energy-balance error, one coupling update's heat (10.5 kJ of 3.68 MJ): the loop logs an
+    # update before LIGGGHTS runs it, so the last update of a stopped run was never applied.
+    import pandas as pd
+
+    from drumflow.coupling.log import heat_removed_until
+
+    dt = 1e-3
+    log = pd.DataFrame({"time_s": [0.0, 0.01, 0.02], "steps": [10, 10, 10],
+                        "heat_to_particles_W": [-100.0, -200.0, -400.0]})
+    # A finished run: every update held for its 10 steps.
+    assert heat_removed_until(log, 0.03, dt) == pytest.approx(100 * 0.01 + 200 * 0.01 + 400 * 0.01)
+    # Stopped at the third update's start: its heat was never applied.
+    assert heat_removed_until(log, 0.02, dt) == pytest.approx(100 * 0.01 + 200 * 0.01)
+    # Half-way through the second update.
+    assert heat_removed_until(log, 0.015, dt) == pytest.approx(100 * 0.01 + 200 * 0.005)
