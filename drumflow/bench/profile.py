@@ -121,14 +121,19 @@ def parse_breakdowns(text: str) -> pd.DataFrame:
     rows: list[dict[str, Any]] = []
     last: tuple[int, float] | None = None
     current: dict[str, Any] | None = None
+    set_up = False
     for line in text.splitlines():
         parts = line.split()
+        if line.startswith("Setting up run"):
+            set_up = True
+            continue
         m = _LOOP.match(line)
         if m:
             step, sim_time = last if last is not None else (np.nan, np.nan)
             current = {"step": step, "sim_time_s": sim_time, "steps": int(m.group(3)),
                        "atoms": int(m.group(4)), "procs": int(m.group(2)),
-                       "loop_s": float(m.group(1)), "breakdown": False}
+                       "loop_s": float(m.group(1)), "breakdown": False, "set_up": set_up}
+            set_up = False
             rows.append(current)
             continue
         row = _thermo_row(parts)
@@ -154,10 +159,40 @@ def parse_breakdowns(text: str) -> pd.DataFrame:
             m = pattern.match(line)
             if m:
                 current[key] = float(m.group(1))
+    _builds_since_previous(rows)
     columns = ["step", "sim_time_s", "steps", "atoms", "procs", "loop_s", "breakdown",
                *(f"{c}_{u}" for c in CATEGORIES for u in ("s", "pct")),
-               *(f"{g}_{u}" for g in GROUPS for u in ("s", "pct")), *_SCALARS]
+               *(f"{g}_{u}" for g in GROUPS for u in ("s", "pct")), *_SCALARS, *_SINCE]
     return pd.DataFrame(rows).reindex(columns=columns)
+
+
+#: Increments of LIGGGHTS' cumulative counters between two printed breakdowns, and the steps
+#: they cover.
+_SINCE = ("neighbor_builds_since", "dangerous_builds_since", "steps_since")
+
+
+def _builds_since_previous(rows: list[dict[str, Any]]) -> None:
+    """Turn LIGGGHTS' build counts into increments, in place.
+
+    "Neighbor list builds" and "Dangerous builds" count from the last run that was set up
+    ("Setting up run"), not per run: the coupling loop's ``run N pre no`` does not reset them,
+    so a breakdown every few intervals prints a running total (measured: 11, 22, 34, 45 ... on
+    consecutive 34-step runs of paper model two). Summing those totals overcounts the builds
+    several times; the increments over the steps since the previous printed count do not.
+    """
+    builds = dangerous = 0.0
+    since_step: float | None = None
+    for row in rows:
+        if row["set_up"] or since_step is None:
+            builds = dangerous = 0.0
+            since_step = float(row["step"]) - row["steps"]
+        if "neighbor_builds" not in row:
+            continue
+        row["neighbor_builds_since"] = row["neighbor_builds"] - builds
+        row["dangerous_builds_since"] = row.get("dangerous_builds", 0.0) - dangerous
+        row["steps_since"] = float(row["step"]) - since_step
+        builds, dangerous = row["neighbor_builds"], row.get("dangerous_builds", 0.0)
+        since_step = float(row["step"])
 
 
 @dataclass(frozen=True)
@@ -263,9 +298,10 @@ def _windows(intervals: pd.DataFrame, loops: pd.DataFrame, coupling: pd.DataFram
             seconds = sampled[f"{name}_pct"] / 100.0 * sampled["loop_s"]
             row[f"{name}_pct"] = 100.0 * float(seconds.sum()) / loop if loop > 0 else np.nan
         row["neighs_per_atom"] = float(sampled["neighs_per_atom"].mean()) if len(sampled) else np.nan
-        row["neighbor_builds_per_1000_steps"] = (1000.0 * float(sampled["neighbor_builds"].sum())
-                                                 / row["sampled_steps"] if row["sampled_steps"] else np.nan)
-        row["dangerous_builds"] = float(sampled["dangerous_builds"].sum()) if len(sampled) else np.nan
+        covered = float(sampled["steps_since"].sum())
+        row["neighbor_builds_per_1000_steps"] = (1000.0 * float(sampled["neighbor_builds_since"].sum())
+                                                 / covered if covered > 0 else np.nan)
+        row["dangerous_builds"] = float(sampled["dangerous_builds_since"].sum()) if len(sampled) else np.nan
         row["liggghts_particle_steps_per_s"] = float((ran["atoms"] * ran["steps"]).sum()
                                                      / ran["loop_s"].sum())
         updates = pd.DataFrame()
@@ -353,7 +389,7 @@ def profile_run(run_dir: Path, window_s: float = WINDOW_S) -> RunProfile:
              *(f"{c}_{u}" for c in CATEGORIES for u in ("pct", "s")),
              *(f"{g}_{u}" for g in GROUPS for u in ("pct", "s")), "comm_overlap_pct",
              "comm_outside_fixes_pct", "other_net_pct",
-             *_SCALARS, "liggghts_particle_steps_per_s", *WALL_COLUMNS, "python_share",
+             *_SCALARS, *_SINCE, "liggghts_particle_steps_per_s", *WALL_COLUMNS, "python_share",
              "particle_steps_per_s"]
     intervals = table[order + [c for c in table.columns if c.startswith("share_")]]
     loops = runs[["attempt", "step", "steps", "atoms", "loop_s", "start_time_s", "end_time_s"]]

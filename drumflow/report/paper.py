@@ -129,6 +129,24 @@ def _time_step(run: RunDir) -> float | None:
     return float(value) if value else None
 
 
+def _loop_time_s(run: RunDir) -> float | None:
+    """LIGGGHTS' loop time summed over every run of every attempt (first run and resumes).
+
+    The wall time a stopped and resumed run actually computed: a span of file times would
+    count the hours between two sessions. Set-up, restart reading and the coupling loop's
+    Python are not in it (``drumflow profile`` has them).
+    """
+    import re
+
+    pattern = re.compile(r"^Loop time of (\S+) on ", flags=re.M)
+    total, found = 0.0, False
+    for log in run.dem_logs():
+        for m in pattern.finditer(log.read_text(errors="replace")):
+            total += float(m.group(1))
+            found = True
+    return total if found else None
+
+
 def _dump_span_s(run: RunDir) -> tuple[float, float] | None:
     """(first, last) modification time of the dump files: when the DEM wrote its output."""
     if not run.dem_dumps.is_dir():
@@ -177,6 +195,8 @@ def run_record(root: Path | str) -> dict[str, Any]:
             source = "newest dump file"
     dem_wall = summary.get("dem_wall_time_s")
     dem_source = "summary.json (the last `drumflow run` call)"
+    if dem_wall is None:
+        dem_wall, dem_source = _loop_time_s(run), "LIGGGHTS loop time, every attempt"
     if dem_wall is None:
         span = _dump_span_s(run)
         if span is not None:

@@ -85,3 +85,22 @@ def test_step_plan_rounds_intervals(smoke_dict: dict) -> None:
     plan = plan_steps(case, choice)
     assert plan.steps * plan.time_step >= case.run.time
     assert abs(plan.dump_interval - case.run.dump_interval) <= 0.5 * plan.time_step
+
+
+@pytest.mark.parametrize(("case_file", "ranks", "grid"), [
+    # Paper model two (1 m of 20 mm particles, 25 diameters per rank at 2 ranks): along the axis,
+    # where the settings study measured 1.61 times the rate of the split across x.
+    ("paper_model_two.toml", 2, "1 1 2"),
+    ("paper_model_two.toml", 4, "1 1 4"),
+    # Thin slices (5 and 6 diameters per rank at 2 ranks): across the drum, as before.
+    ("smoke.toml", 2, "2 1 1"),
+    ("paper_model_one.toml", 2, "2 1 1"),
+    ("smoke.toml", 1, "1 1 1"),
+])
+def test_processor_grid_along_the_axis_only_for_thick_sections(case_file: str, ranks: int, grid: str) -> None:
+    from support.solvers import CASES
+
+    from drumflow.case import load_case
+    from drumflow.dem.deck import processors_grid
+
+    assert processors_grid(load_case(CASES / case_file), ranks) == grid

@@ -294,3 +294,28 @@ def test_snapshot_panels_draw_first_and_last_snapshot_on_one_scale(
     empty = RunDir.existing(write_synthetic_run(tmp_path / "bare", extras=False))
     with pytest.raises(RunDirectoryError, match="no particle snapshot"):
         render_snapshot_panels(empty, case, tmp_path / "none.png")
+
+
+def test_dem_wall_time_of_a_resumed_run_is_its_loop_time_not_a_file_time_span(
+        tmp_path: Path, write_synthetic_run: Callable[..., Any]) -> None:
+    # Regression: model two's record said 14,076 s of DEM from the first and newest dump files'
+    # times, which counted the 80 minutes between two sessions; LIGGGHTS' loops took 8,893 s.
+    import json as _json
+    import os
+
+    from drumflow.report.paper import run_record
+
+    root = write_synthetic_run(tmp_path / "run")
+    summary = _json.loads((root / "summary.json").read_text())
+    summary.pop("dem_wall_time_s", None)
+    (root / "summary.json").write_text(_json.dumps(summary))
+    dem = root / "dem"
+    (dem / "log.liggghts").write_text("Loop time of 100.5 on 2 procs for 34 steps with 9 atoms\n"
+                                      "Loop time of 0.5 on 2 procs for 34 steps with 9 atoms\n")
+    (dem / "log.resume-68.liggghts").write_text("Loop time of 4e-06 on 2 procs for 0 steps with 9 atoms\n"
+                                                "Loop time of 99 on 2 procs for 34 steps with 9 atoms\n")
+    for k, dump in enumerate(sorted(dem.glob("dumps/*.txt"))):
+        os.utime(dump, (1e9 + 86400 * k, 1e9 + 86400 * k))
+    record = run_record(root)
+    assert record["dem_wall_time_s"] == pytest.approx(200.000004)
+    assert "loop time" in record["dem_wall_time_source"]

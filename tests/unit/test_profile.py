@@ -135,3 +135,31 @@ def test_text_without_a_run_gives_an_empty_table() -> None:
     table = parse_breakdowns("LIGGGHTS (Version LIGGGHTS-PUBLIC 3.8.0)\n  500 atoms\n")
     assert table.empty
     assert {"step", "loop_s", "pair_pct", "walls_pct"} <= set(table.columns)
+
+
+def test_build_counts_are_running_totals_between_set_ups() -> None:
+    # Regression: LIGGGHTS counts neighbour-list builds from the last run that was set up, and
+    # the coupling loop's `run N pre no` is not; summing the printed totals overcounted the
+    # builds 3.5 times in the paper-scale settings study. Counts below are model two's (2
+    # ranks, consecutive 34-step runs from the 3.47 s restart, each ending with `post yes`).
+    def block(step: int, builds: int, dangerous: int = 0) -> str:
+        return (f"    {step} 1.0 299164 1 1 88 0.004 0\n"
+                f"Loop time of 17.0 on 2 procs for 34 steps with 299164 atoms, finish time x\n"
+                f"Pair  time (%) = 1 (100)\nNeighbor list builds = {builds}\n"
+                f"Dangerous builds = {dangerous}\n")
+
+    text = ("Setting up run at Mon Nov 23 22:22:24 2026\n    11662 3.47 299164 1 1 88 0.004 0\n"
+            "Loop time of 4.1e-06 on 2 procs for 0 steps with 299164 atoms, finish time x\n"
+            "Neighbor list builds = 0\nDangerous builds = 0\n"
+            + block(11696, 11) + block(11730, 22) + block(11764, 34, 1)
+            # A later set-up (a run the deck issued itself) starts the count again.
+            + "Setting up run at y\n" + block(11798, 12))
+    table = parse_breakdowns(text)
+    done = table[table["steps"] > 0]
+    assert done["neighbor_builds_since"].tolist() == [11, 11, 12, 12]
+    assert done["dangerous_builds_since"].tolist() == [0, 0, 1, 0]
+    assert done["steps_since"].tolist() == [34, 34, 34, 34]
+    # A breakdown only every other run: the increment covers both runs' steps.
+    sparse = parse_breakdowns(text.replace("Neighbor list builds = 11\n", ""))
+    row = sparse[sparse["step"] == 11730].iloc[0]
+    assert (row["neighbor_builds_since"], row["steps_since"]) == (22, 68)
