@@ -1,4 +1,5 @@
-"""`drumflow export RUN_DIR --vtk`: a run directory as ParaView files.
+"""`drumflow export RUN_DIR --vtk | --animation`: a run directory as ParaView files, or as an
+animated GIF of the section coloured by temperature (Figure 6 in motion).
 
 Exit codes (:func:`drumflow.errors.exit_code`): 0 written, 2 bad input (no format chosen, not a
 run directory, missing snapshots or geometry).
@@ -23,15 +24,24 @@ def export(
     run_dir: Annotated[Path, typer.Argument(help="run directory written by `drumflow run`")],
     vtk: Annotated[bool, typer.Option(
         "--vtk", help="particles (.vtu + .pvd), walls at each snapshot's drum angle, air (.vti)")] = False,
+    animation: Annotated[bool, typer.Option(
+        "--animation", help="the section coloured by temperature at every snapshot, as a GIF "
+        "(RUN_DIR/post/section_temperature.gif unless --out)")] = False,
+    speed: Annotated[float, typer.Option(
+        "--seconds-per-simulated-second", min=0.01, max=100.0,
+        help="--animation: playback seconds per simulated second")] = 1.0,
     out: Annotated[Optional[Path], typer.Option(
-        "--out", "-o", help="output folder (default RUN_DIR/vtk)")] = None,
+        "--out", "-o", help="output folder (--vtk, default RUN_DIR/vtk) or GIF file (--animation)")] = None,
     as_json: Annotated[bool, typer.Option("--json", help="print what was written as JSON")] = False,
 ) -> None:
-    """Write a run's snapshots, walls and air field for ParaView."""
+    """Write a run's snapshots, walls and air field for ParaView, or its section animation."""
     from drumflow.report.vtk import export_vtk
 
-    if not vtk:
-        raise RunDirectoryError("no export format chosen; allowed: --vtk")
+    if vtk == animation:
+        raise RunDirectoryError("choose one export format: --vtk or --animation")
+    if animation:
+        _animation(run_dir, out, speed, as_json)
+        return
     result = export_vtk(run_dir, out)
     if as_json:
         console.print_json(json.dumps(result.as_dict()))
@@ -47,3 +57,21 @@ def export(
     console.print(table)
     console.print(f"open in ParaView: paraview {Path(result.out) / result.particles_pvd} "
                   f"{Path(result.out) / result.walls_pvd}", highlight=False)
+
+
+def _animation(run_dir: Path, out: Path | None, speed: float, as_json: bool) -> None:
+    from drumflow.case import load_case
+    from drumflow.report.animation import render_animation
+    from drumflow.rundir import RunDir
+
+    run = RunDir.existing(run_dir)
+    result = render_animation(run, load_case(run.case_toml), out, seconds_per_simulated_second=speed)
+    if as_json:
+        console.print_json(json.dumps(result.as_dict()))
+        return
+    times = result.times_s
+    console.print(f"{result.path}: {result.frames} frames, t = {times[0]:.3g}-{times[-1]:.3g} s at "
+                  f"{result.fps:.3g} frames/s, colour scale {result.temperature_range_C[0]:.2f}-"
+                  f"{result.temperature_range_C[1]:.2f} °C", highlight=False)
+    if result.skipped:
+        console.print(f"[yellow]unreadable snapshots skipped: {', '.join(result.skipped)}[/yellow]")

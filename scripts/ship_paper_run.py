@@ -16,6 +16,8 @@ Copies from a ``drumflow run`` directory (finished, or interrupted and post-proc
 * ``air/solution.json`` (the OpenFOAM solve: cells, residuals, mass flows);
 * ``post/particles_times.png``: Figure 6 as the paper draws it, the section at up to four
   snapshot times on one colour scale (drawn here: the snapshots are not shipped);
+* ``post/section_temperature.gif``: Figure 6 in motion, the section at every snapshot
+  (:func:`drumflow.report.animation.render_animation`);
 * ``post/air_side.json``: the bed and airborne h of the last snapshot in the run's air field,
   and ``post/particles_3d.png`` (Figure 6), both computed here because the snapshot and the
   100 MB air field are not shipped;
@@ -42,6 +44,7 @@ import pandas as pd
 from drumflow.analysis.methodology import _json_safe, analyse_run, write_methodology
 from drumflow.case import load_case
 from drumflow.errors import DrumflowError, RunDirectoryError, exit_code
+from drumflow.report.animation import ANIMATION, render_animation
 from drumflow.report.paper import (
     AIR_SIDE,
     CROSSINGS_SUMMARY,
@@ -153,6 +156,10 @@ def ship(run_dir: Path, dest: Path, *, render_3d: bool = True, crossings_limit_m
         render_snapshot_panels(run, case, dest / "post" / PARTICLES_TIMES)
     except (DrumflowError, OSError) as exc:
         notes.append(f"Figure 6 (snapshots over time) not drawn: {exc}")
+    try:
+        render_animation(run, case, dest / "post" / ANIMATION)
+    except (DrumflowError, OSError) as exc:
+        notes.append(f"Figure 6 in motion (animation) not drawn: {exc}")
 
     record = run_record(run.root)
     files = sorted(p for p in dest.rglob("*") if p.is_file() and p.name != RUN_RECORD)

@@ -110,8 +110,12 @@ def _file_uri(path: Path) -> str | None:
         data = path.read_bytes()
     except OSError:
         return None
-    # Only PNG files are embedded: the page promises PNG data URIs and nothing else.
-    return _png_uri(data) if data.startswith(b"\x89PNG\r\n\x1a\n") else None
+    # Only PNG pictures and GIF animations are embedded, each under its own type.
+    if data.startswith(b"\x89PNG\r\n\x1a\n"):
+        return _png_uri(data)
+    if data.startswith((b"GIF87a", b"GIF89a")):
+        return "data:image/gif;base64," + base64.b64encode(data).decode("ascii")
+    return None
 
 
 def _plt():  # type: ignore[no-untyped-def]

@@ -61,6 +61,7 @@ from drumflow.analysis.paper import (
 )
 from drumflow.case import Case, load_case
 from drumflow.errors import AnalysisInputError, DrumflowError, RunDirectoryError
+from drumflow.report.animation import ANIMATION, render_animation
 from drumflow.report.html import (
     _fig_uri,
     _Figure,
@@ -484,6 +485,11 @@ def collect_paper_run(root: Path | str, model: Model, *, render_3d: bool = True,
             render_snapshot_panels(run, case, run.post / PARTICLES_TIMES)
         except (DrumflowError, OSError) as exc:
             notes.append(f"Figure 6 (snapshots over time) not drawn: {exc}")
+    if kind == "run" and case is not None and not (run.post / ANIMATION).is_file():
+        try:
+            render_animation(run, case, run.post / ANIMATION)
+        except (DrumflowError, OSError) as exc:
+            notes.append(f"Figure 6 in motion (animation) not drawn: {exc}")
     if kind == "run" and render_3d and case is not None:
         target = run.post / PARTICLES_3D
         if not target.is_file():
@@ -683,6 +689,11 @@ def _run_tables_and_figures(run: PaperRun) -> tuple[list[_Table], list[_Figure]]
     if over_time.uri is None:
         over_time.note = f"no post/{PARTICLES_TIMES} (no snapshot, or not shipped)"
     figures.append(over_time)
+    motion = _Figure("Figure 6 in motion: the section at every snapshot, coloured by temperature",
+                     uri=_file_uri(run.root / "post" / ANIMATION))
+    if motion.uri is None:
+        motion.note = f"no post/{ANIMATION} (no snapshot, or not shipped)"
+    figures.append(motion)
     air = _file_uri(run.root / "air" / "air_cross_section.png")
     if air is not None:
         figures.append(_Figure("Air field, cross-section", uri=air))

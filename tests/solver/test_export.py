@@ -107,3 +107,25 @@ def test_walls_turn_with_the_drum(run_dir: Path, tmp_path: Path) -> None:
         # Hertz overlaps here are below 1% of r (soft 5 MPa spheres at these speeds); 0.9 r
         # leaves a margin of ten times that and still fails for any wrong angle (see above).
         assert int((distance < 0.9 * r).sum()) == 0, t
+
+
+@pytest.mark.timeout(600)
+def test_animation_has_a_frame_per_snapshot(run_dir: Path, tmp_path: Path) -> None:
+    from PIL import Image
+
+    from drumflow.dem.dumps import dump_files
+
+    gif = tmp_path / "section.gif"
+    proc = subprocess.run(
+        [sys.executable, "-m", "drumflow.cli", "export", str(run_dir), "--animation", "--out", str(gif),
+         "--json"], capture_output=True, text=True, timeout=300, check=False)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    info = json.loads(proc.stdout)
+    snaps = dump_files(run_dir / "dem" / "dumps", "snap")
+    with Image.open(gif) as image:
+        assert image.n_frames == len(snaps) == info["frames"] >= 5
+        # Snapshots every 0.1 s played in real time: 10 frames a second, 100 ms per frame.
+        assert image.info["duration"] == pytest.approx(100, abs=1)
+    assert info["fps"] == 10
+    lo, hi = info["temperature_range_C"]
+    assert lo < hi <= 90.0 + 1e-6  # the particles start at 90 C and only cool

@@ -116,8 +116,16 @@ def test_shipped_results_are_small_and_redraw_the_same_numbers(paper_run: dict[s
     assert sum(record["files"].values()) < 5e6
     for rel in ("manifest.json", "case.toml", "summary.json", "post/mean_temperature.csv",
                 "post/crossings.csv", "post/air_heat.csv", "post/methodology.json", "post/steps.csv",
-                "air/solution.json", "post/air_side.json"):
+                "air/solution.json", "post/air_side.json", "post/section_temperature.gif"):
         assert (shipped / rel).is_file(), rel
+    # Figure 6 in motion: one frame per snapshot of the run, embedded in the redrawn page.
+    from PIL import Image
+
+    from drumflow.dem.dumps import dump_files
+
+    with Image.open(shipped / "post" / "section_temperature.gif") as gif:
+        assert gif.n_frames == len(dump_files(paper_run["out"] / "model_two" / "dem" / "dumps", "snap"))
+    assert "data:image/gif;base64," in (paper_run["root"] / "out2" / "paper.html").read_text()
     run_rows = paper_run["first"]["models"]["two"]["comparison"]
     redrawn = paper_run["redrawn"]["models"]["two"]
     assert redrawn["kind"] == "shipped"

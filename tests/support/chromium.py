@@ -16,7 +16,7 @@ from numpy.typing import NDArray
 
 CHROMIUM = shutil.which("chromium")
 
-_PNG_URI = r'src="data:image/png;base64,([^"]*)"'
+_PICTURE_URI = r'src="data:image/(png|gif);base64,([^"]*)"'
 
 
 def screenshot(html: Path, png: Path, profile: Path, size: tuple[int, int] = (1200, 2000)) -> None:
@@ -34,13 +34,17 @@ def screenshot(html: Path, png: Path, profile: Path, size: tuple[int, int] = (12
 
 
 def _solid_red_like(match: re.Match[str]) -> str:
-    """A data URI of a solid red PNG with the pixel size of the matched PNG data URI."""
+    """A data URI of a solid red PNG with the pixel size of the matched PNG or GIF data URI."""
     import matplotlib.image as mpimg
 
-    data = base64.b64decode(match.group(1))
-    # PNG header: 8-byte signature, IHDR chunk length and type, then width and height (big
-    # endian, 4 bytes each) at bytes 16-24.
-    width, height = struct.unpack(">II", data[16:24])
+    data = base64.b64decode(match.group(2))
+    if match.group(1) == "png":
+        # PNG header: 8-byte signature, IHDR chunk length and type, then width and height (big
+        # endian, 4 bytes each) at bytes 16-24.
+        width, height = struct.unpack(">II", data[16:24])
+    else:
+        # GIF header: 6-byte signature, then width and height (little endian, 2 bytes each).
+        width, height = struct.unpack("<HH", data[6:10])
     buf = io.BytesIO()
     mpimg.imsave(buf, np.tile(np.array([1.0, 0.0, 0.0]), (height, width, 1)), format="png")
     return 'src="data:image/png;base64,' + base64.b64encode(buf.getvalue()).decode() + '"'
@@ -61,7 +65,7 @@ def shots_with_red_pictures(html: Path, workdir: Path, size: tuple[int, int]
     assert png.is_file() and png.stat().st_size > 0
     shot = mpimg.imread(png)[..., :3].astype(np.float64)
     red_html = workdir / "red.html"
-    red_html.write_text(re.sub(_PNG_URI, _solid_red_like, html.read_text()), encoding="utf-8")
+    red_html.write_text(re.sub(_PICTURE_URI, _solid_red_like, html.read_text()), encoding="utf-8")
     red_png = workdir / "red.png"
     screenshot(red_html, red_png, workdir / "chromium-profile-2", size=size)
     red_shot = mpimg.imread(red_png)[..., :3].astype(np.float64)

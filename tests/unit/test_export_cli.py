@@ -14,11 +14,12 @@ import pytest
     ("args", "message"),
     [
         (["--vtk"], "not a directory"),
-        ([], "no export format chosen; allowed: --vtk"),
+        ([], "choose one export format: --vtk or --animation"),
+        (["--vtk", "--animation"], "choose one export format: --vtk or --animation"),
     ],
 )
 def test_export_bad_input(tmp_path: Path, args: list[str], message: str) -> None:
-    target = tmp_path / "missing" if args else tmp_path
+    target = tmp_path / "missing" if args == ["--vtk"] else tmp_path
     out = subprocess.run([sys.executable, "-m", "drumflow.cli", "export", str(target), *args],
                          capture_output=True, text=True, timeout=120, check=False)
     text = out.stdout + out.stderr
