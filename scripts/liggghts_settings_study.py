@@ -78,6 +78,14 @@ class Variant:
         before the box is defined, i.e. before ``read_restart``, where the deck has it.
     min_ranks
         Skipped with fewer MPI ranks.
+    time_step_factor
+        The deck's time step times this. The variant runs ``--steps / factor`` steps (the same
+        simulated time as the baseline, so that its speed-up is per simulated second), the air is
+        updated every ``interval / factor`` steps (the same period in time) and the coupling
+        loop's clock starts at the restart's time (``clock_origin``).
+    moving_shell
+        The shell as a rotating mesh (``move/mesh``) like the lifters, instead of the static
+        shell with a surface velocity: the wall treatment of the conservative reference.
     """
 
     name: str
@@ -87,6 +95,8 @@ class Variant:
     atom_modify: str | None = None
     processors: str | None = None
     min_ranks: int = 1
+    time_step_factor: float = 1.0
+    moving_shell: bool = False
 
 
 #: What is compared. The deck's own settings are the baseline: ``neighbor SKIN bin`` (half a
@@ -107,6 +117,14 @@ VARIANTS: list[Variant] = [
     Variant("grid_x", "processor grid across the drum, along x", processors="{np} 1 1", min_ranks=2),
     Variant("grid_y", "processor grid across the drum, along y (gravity)", processors="1 {np} 1",
             min_ranks=2),
+    # The time-to-answer reference of issue 11: half the default step (20 steps per Hertz
+    # contact at the free-fall speed instead of 10; 10 % of the Rayleigh time is longer for the
+    # paper's soft particles) and the moving-mesh shell; then also on the grid across the drum,
+    # i.e. the reference as drumflow ran it before the axial grid.
+    Variant("conservative", "half the time step (20 steps per contact) and the moving-mesh shell",
+            time_step_factor=0.5, moving_shell=True),
+    Variant("conservative_grid_x", "conservative, on the processor grid across the drum (x)",
+            time_step_factor=0.5, moving_shell=True, processors="{np} 1 1", min_ranks=2),
 ]
 
 #: Mean temperature after the steps: within this fraction of the baseline's change over them...
@@ -147,7 +165,33 @@ def apply_variant(deck: str, variant: Variant, ranks: int) -> str:
     if variant.processors is not None:
         deck = _replace_line(deck, r"^processors\s+.*$",
                              f"processors      {variant.processors.format(np=ranks)}")
+    if variant.time_step_factor != 1.0:
+        m = re.search(r"^timestep\s+(\S+)\s*$", deck, flags=re.M)
+        if m is None:
+            raise StudyError("deck: no `timestep DT` line")
+        dt = float(m.group(1)) * variant.time_step_factor
+        deck = _replace_line(deck, r"^timestep\s+.*$", f"timestep        {dt:.12g}")
+    if variant.moving_shell:
+        pattern = (r"^fix shell all mesh/surface file (\S+) type 2 surface_ang_vel origin (\S+ \S+ \S+) "
+                   r"axis (\S+ \S+ \S+) omega (\S+)\s*$")
+        m = re.search(pattern, deck, flags=re.M)
+        if m is None:
+            raise StudyError("deck: no static shell (surface_ang_vel) to turn into a moving mesh")
+        period = 2.0 * math.pi / float(m.group(4))
+        deck = _replace_line(deck, r"^fix shell all mesh/surface .*$",
+                             f"fix shell all mesh/surface file {m.group(1)} type 2")
+        walls = re.search(r"^fix walls all wall/gran .*$", deck, flags=re.M)
+        if walls is None:
+            raise StudyError("deck: no `fix walls` line")
+        line = (f"\nfix spin_shell all move/mesh mesh shell rotate origin {m.group(2)} axis {m.group(3)} "
+                f"period {period:.12g}")
+        deck = deck[:walls.end()] + line + deck[walls.end():]
     return deck
+
+
+def variant_steps(steps: int, variant: Variant) -> int:
+    """DEM steps of a variant: the baseline's simulated time at the variant's time step."""
+    return max(1, round(steps / variant.time_step_factor))
 
 
 def _restart(rundir: RunDir, step: int | None) -> tuple[Path, int]:
@@ -189,7 +233,7 @@ def baseline_deck(rundir: RunDir, restart_step: int, ranks: int, scratch: Path,
 
 
 def _prepare(folder: Path, rundir: RunDir, restart: Path, deck: str, driver: dict[str, Any],
-             end_step: int) -> None:
+             end_step: int, time_step_factor: float = 1.0, start_step: int = 0) -> None:
     """A run-directory-like folder: case, geometry, the deck, the restart (linked, read only)
     and the coupling loop's input for ``end_step``."""
     if folder.exists():
@@ -205,6 +249,11 @@ def _prepare(folder: Path, rundir: RunDir, restart: Path, deck: str, driver: dic
     spec = {k: v for k, v in driver.items() if k != "stop"}  # exactly --steps steps
     spec.update(deck="in.drum.resume", log="log.liggghts", total_steps=end_step, tail=[],
                 profile_every_steps=1)  # a breakdown after every coupling interval
+    if time_step_factor != 1.0:
+        dt = float(driver["time_step"])
+        spec.update(time_step=dt * time_step_factor,
+                    interval=max(1, round(int(driver["interval"]) / time_step_factor)),
+                    clock_origin=[start_step, start_step * dt])
     (dem / COUPLING_FILE).write_text(json.dumps(spec, indent=2))
 
 
@@ -286,8 +335,10 @@ def run_study(run_dir: Path, steps: int, ranks: int, out: Path, scratch: Path,
             rows.append({**row, "status": f"skipped: the baseline's grid ({grid})"})
             continue
         folder = scratch / variant.name
-        _prepare(folder, rundir, restart, apply_variant(deck, variant, ranks), driver, start + steps)
-        sys.stderr.write(f"{variant.name}: {steps} steps from step {start} on {ranks} rank(s)...\n")
+        n_steps = variant_steps(steps, variant)
+        _prepare(folder, rundir, restart, apply_variant(deck, variant, ranks), driver, start + n_steps,
+                 variant.time_step_factor, start)
+        sys.stderr.write(f"{variant.name}: {n_steps} steps from step {start} on {ranks} rank(s)...\n")
         t0 = time.perf_counter()
         try:
             record = runner.run("liggghts", driver_command(runner.profile, ranks, COUPLING_FILE),
@@ -299,7 +350,7 @@ def run_study(run_dir: Path, steps: int, ranks: int, out: Path, scratch: Path,
             rows.append({**row, "status": f"failed: {exc}"[:300]})
             continue
         row.update(status="ok", wall_s=record.wall_time_s or time.perf_counter() - t0,
-                   **_measure(folder, steps))
+                   time_step_factor=variant.time_step_factor, **_measure(folder, n_steps))
         if base is None:
             base = row
         row.update(physics_check(row, base))

@@ -134,6 +134,18 @@ def run(spec_path: Path) -> int:
     omega = float(spec["omega"])
     dt = float(spec["time_step"])
     total = int(spec["total_steps"])
+    # The simulated time is origin + (step - origin step) * dt. A run that keeps one time step
+    # throughout has the origin (0, 0); a run continued from a restart with another time step
+    # (the settings study's time-step variants) gives the restart's step and time, so that the
+    # air field stands at the drum angle of the restart, not at step * new dt.
+    origin_step, origin_time = (int(spec.get("clock_origin", [0, 0.0])[0]),
+                                float(spec.get("clock_origin", [0, 0.0])[1]))
+    if (origin_step, origin_time) != (0, 0.0) and spec.get("stop"):
+        raise ValueError("clock_origin with a stop rule: the stop rule's clock is step * dt")
+
+    def clock(at_step: int) -> float:
+        return origin_time + (at_step - origin_step) * dt
+
     interval = int(spec["interval"])
     stride = profile_stride(interval, int(spec.get("profile_every_steps", PROFILE_EVERY_STEPS)))
     lmp = Liggghts(["-log", spec["log"], "-echo", "none"])
@@ -155,7 +167,7 @@ def run(spec_path: Path) -> int:
     record_crossings = spec.get("crossings") == "loop"
     if record_crossings:
         lmp.command("undump cross")
-    tracker = (CrossingTracker(int(spec["particles"]), work, rank, record_crossings, start * dt)
+    tracker = (CrossingTracker(int(spec["particles"]), work, rank, record_crossings, clock(start))
                if monitor is not None or record_crossings else None)
     stopped = False
     updates = 0
@@ -168,10 +180,10 @@ def run(spec_path: Path) -> int:
             v = lmp.atom_array("v")
             d = 2.0 * lmp.atom_vector("radius")
             T = lmp.fix_vector("Temp")
-            u = air_velocity_at(field, x, step * dt, omega)
+            u = air_velocity_at(field, x, clock(step), omega)
             force = drag_force(u, v, d, air)
             heat = convective_heat(u, v, T, d, air)
-            found = tracker.update(lmp, step * dt) if tracker is not None else None
+            found = tracker.update(lmp, clock(step)) if tracker is not None else None
             if monitor is not None and monitor.observe(step, n, heat, d, T,
                                                        lmp.atom_vector("rmass"), found):
                 # Before this update's heat is applied or logged: the heat log stays exactly
@@ -182,7 +194,7 @@ def run(spec_path: Path) -> int:
                 lmp.fix_vector(name)[:] = force[:, k]
             lmp.fix_vector("heatSource")[:] = heat
             slip = float(np.linalg.norm(u - v, axis=1).mean()) if len(v) else 0.0
-            row = (step, step * dt, n, float(heat.sum()), *map(float, force.sum(axis=0)), len(v), slip)
+            row = (step, clock(step), n, float(heat.sum()), *map(float, force.sum(axis=0)), len(v), slip)
             python_wall = time.perf_counter() - started
             # The row without its last column, flushed before the run: an interrupted run is
             # resumed from a restart file, and the heat applied before that restart must survive
@@ -204,7 +216,7 @@ def run(spec_path: Path) -> int:
     if tracker is not None:
         if not stopped:
             # The crossings of the last interval, up to the final step.
-            tracker.update(lmp, step * dt)
+            tracker.update(lmp, clock(step))
         tracker.close()
     if monitor is not None:
         monitor.finish(step, stopped)

@@ -99,7 +99,8 @@ def test_settings_study_from_the_restart(run: Path, tmp_path: Path) -> None:
             assert str(row["status"]).startswith("skipped"), v.name
             continue
         assert row["status"] == "ok", (v.name, row["status"])
-        assert row["steps"] == 100
+        # A time-step variant covers the baseline's simulated time.
+        assert row["steps"] == round(100 / v.time_step_factor)
         assert row["particle_steps_per_s"] > 0
         assert abs(sum(row[f"{c}_pct"] for c in ("pair", "neigh", "comm", "output", "modify", "other"))
                    - 100.0) < ROUNDING
@@ -108,5 +109,18 @@ def test_settings_study_from_the_restart(run: Path, tmp_path: Path) -> None:
     deck = (out.parent / "variants" / "skin_x2" / "dem" / "in.drum.resume").read_text()
     base = (out.parent / "variants" / "baseline" / "dem" / "in.drum.resume").read_text()
     assert deck != base and "neighbor        0.008 bin" in deck
+    # The conservative reference: half the step, the shell a rotating mesh, and the air clock
+    # continuing from the restart's time (not step x the new step).
+    folder = out.parent / "variants" / "conservative" / "dem"
+    conservative = (folder / "in.drum.resume").read_text()
+    assert "fix spin_shell all move/mesh mesh shell rotate" in conservative
+    assert "surface_ang_vel" not in conservative
+    dt_base = json.loads((out.parent / "variants" / "baseline" / "dem" / "coupling.json").read_text())
+    spec = json.loads((folder / "coupling.json").read_text())
+    assert spec["time_step"] == pytest.approx(0.5 * dt_base["time_step"], rel=1e-12)
+    start = spec["clock_origin"][0]
+    log = pd.read_csv(folder / "coupling" / f"rank0.{start}.csv")  # the times the loop used
+    assert log["time_s"].iloc[0] == pytest.approx(start * dt_base["time_step"], rel=1e-9)
+    assert spec["interval"] == 2 * dt_base["interval"]  # the same air-update period in time
     meta = json.loads(out.with_suffix(".json").read_text())
     assert meta["steps"] == 100 and meta["machine"]["cpus"] >= 1
