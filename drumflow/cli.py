@@ -15,6 +15,7 @@ from pathlib import Path
 from typing import Annotated, Any
 
 import typer
+from rich import box
 from rich.console import Console
 from rich.progress import (
     BarColumn,
@@ -499,6 +500,81 @@ def profile(
     console.print(table)
     console.print(f"{len(result.intervals)} sampled intervals; written: "
                   + ", ".join(str(p) for p in paths.values()), highlight=False)
+
+
+@app.command()
+def answer(
+    run_dir: Annotated[Path, typer.Argument(help="run directory after `drumflow post`, or a shipped "
+                                            "results folder (case.toml, post/)")],
+    tolerance: Annotated[
+        float, typer.Option("--tolerance", help="the stop rule's largest relative half-width, and "
+                            "how close to the reference counts as settled")
+    ] = 0.01,
+    every: Annotated[
+        float, typer.Option("--every", help="spacing of the replayed end times, simulated seconds")
+    ] = 0.1,
+    rate: Annotated[
+        float | None, typer.Option("--rate", help="particle-steps per wall second for updates "
+                                   "without logged wall times (default: the logged ones', else "
+                                   "run_record.json)")
+    ] = None,
+    out: Annotated[
+        Path | None, typer.Option("--out", "-o", help="folder for answer.csv, answer.json and "
+                                  "answer.png (default: RUN_DIR/post)")
+    ] = None,
+    as_json: Annotated[bool, typer.Option("--json", help="print answer.json instead of a table")] = False,
+) -> None:
+    """Time to answer: what a run stopped earlier would report, and when the stop rule fires."""
+    from drumflow.bench.answer import QUANTITIES, replay_answer, write_answer
+    from drumflow.rundir import RunDir
+
+    replay = replay_answer(run_dir, tolerance=tolerance, settle_tolerance=tolerance,
+                           check_interval_s=every, particle_steps_per_s=rate)
+    folder = out or RunDir.existing(run_dir).post
+    paths = write_answer(replay, folder, title=f"{run_dir.name}: time to answer")
+    summary = replay.to_dict()
+    if as_json:
+        console.print_json(json.dumps({**summary, "files": {k: str(v) for k, v in paths.items()}}))
+        return
+    table = Table(title=f"{run_dir.name}: what a run stopped at t reports (Δ: against "
+                  f"{replay.reference_time_s:.4g} s; rule: widest interval, fires at ±{tolerance:.0%})",
+                  box=box.SIMPLE, padding=(0, 1))
+    cols = [("t s", "time_s", "{:.2f}"), ("T3.5 °C", "temperature_C", "{:.3f}"),
+            ("Δ", "rel_temperature", "{:+.2%}"), ("ṁ kg/s", "mass_flow_kg_s", "{:.2f}"),
+            ("Δ", "rel_mass_flow", "{:+.1%}"), ("h W/m²K", "h_W_m2K", "{:.2f}"),
+            ("Δ", "rel_h", "{:+.2%}"), ("rule ±", "converged", "{}"), ("wall s", "wall_s", "{:,.0f}")]
+    for title, _, _ in cols:
+        table.add_column(title, justify="right")
+    for _, row in replay.table.iterrows():
+        cells = []
+        for _, key, fmt in cols:
+            value = row[key]
+            if key == "converged":
+                # The wider of the two intervals the rule compares with the tolerance.
+                widest = max(row["monitor_h_rel_half_width"], row["monitor_mass_flow_rel_half_width"])
+                cells.append("fires" if value else "-" if widest != widest else f"{widest:.1%}")
+            else:
+                cells.append("-" if value is None or value != value else fmt.format(value))
+        table.add_row(*cells)
+    console.print(table)
+    rule = summary["rule"]
+    if rule["first_fire_s"] is None:
+        console.print(f"stop rule: {rule['reason']}", highlight=False)
+    else:
+        console.print(f"stop rule: fires at {rule['first_fire_s']:.4g} s (wall "
+                      f"{rule['wall_at_first_fire_s'] or float('nan'):,.0f} s): {rule['reason']}",
+                      highlight=False)
+    for name, (_, label) in QUANTITIES.items():
+        when = replay.settled_s[name]
+        value = summary["reference"]["values"][name]
+        console.print(f"{label} = {value:.6g}: within {tolerance:.0%} from "
+                      f"{'never' if when is None else f'{when:.4g} s'}", highlight=False)
+    wall = replay.wall
+    console.print(f"wall time: {wall['source']} (rate {wall['particle_steps_per_s'] or float('nan'):,.0f} "
+                  f"particle-steps/s from {wall['rate_source']})", highlight=False)
+    for note in replay.notes:
+        console.print(f"note: {note}", highlight=False)
+    console.print("written: " + ", ".join(str(p) for p in paths.values()), highlight=False)
 
 
 # Last, after every command (and the groups above) is registered: one wrapper for all.

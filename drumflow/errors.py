@@ -300,6 +300,37 @@ class NoHeatTransferError(RunDirectoryError):
     """The run cannot give a heat-transfer coefficient (no air, no cooling, no falling mass)."""
 
 
+class RunTooShortError(RunDirectoryError):
+    """A run directory holds less simulated time than an analysis needs.
+
+    Parameters
+    ----------
+    path
+        The file whose last time was read (absolute).
+    simulated_time_s
+        The simulated time it reaches, s.
+    required_s
+        The least simulated time the analysis needs, s.
+    why
+        Where the requirement comes from, for the message (e.g. "run.mass_flow_start + 1 s").
+
+    Attributes
+    ----------
+    path, simulated_time_s, required_s
+        As given.
+    """
+
+    def __init__(self, path: Path, simulated_time_s: float, required_s: float, why: str) -> None:
+        self.path = path
+        self.simulated_time_s = simulated_time_s
+        self.required_s = required_s
+        super().__init__(
+            f"{path}: the run reaches {simulated_time_s:.4g} s of simulated time; allowed: a run "
+            f"of at least {required_s:.4g} s ({why}); run it longer (or resume it) and rerun "
+            "`drumflow post DIR`"
+        )
+
+
 class RenderError(DrumflowError, RuntimeError):
     """The particle picture could not be rendered (no OpenGL, crash, time limit, bad data)."""
 

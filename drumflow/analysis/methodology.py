@@ -391,6 +391,7 @@ def analyse_run(
     *,
     nusselt_conductivity: NusseltConductivity = "air",
     falling_mass: FallingMassMode = "mean",
+    until: float | None = None,
 ) -> MethodologyResult:
     """Apply the paper's methodology to one run directory (Tables 6 and 7, Eqs. 34-55).
 
@@ -406,6 +407,10 @@ def analyse_run(
     falling_mass
         ``"mean"`` (default, the paper's averaged ``m_mf``) or ``"per_step"``; see the module
         notes.
+    until
+        If given, analyse only the output times up to this simulated time (s): what a run
+        stopped there would report (the falling-mass window then ends there too). Default: the
+        whole run. A time past the end of the run means the whole run.
 
     Returns
     -------
@@ -425,7 +430,8 @@ def analyse_run(
     drumflow.errors.CaseError
         If ``case.toml`` is not a valid case.
     ValueError
-        If ``nusselt_conductivity`` or ``falling_mass`` is not one of the allowed values.
+        If ``nusselt_conductivity`` or ``falling_mass`` is not one of the allowed values, or
+        ``until`` leaves fewer than two output times (an ``AnalysisInputError``).
     """
     if nusselt_conductivity not in ("air", "particle"):
         raise AnalysisInputError("nusselt_conductivity", nusselt_conductivity, "'air' or 'particle'")
@@ -435,6 +441,8 @@ def analyse_run(
     case = load_case(run.case_toml)
     _require_air(case, run.case_toml)
     series = _read_series(run.mean_temperature_csv)
+    if until is not None:
+        series = _series_until(series, until)
     window = _falling_window_of(series, case, run.mean_temperature_csv)
     steps = _per_step(case, series, window, falling_mass, run)
     h_mean = _mean_h(steps, series, run.mean_temperature_csv)
@@ -532,6 +540,16 @@ def _read_series(csv_path: Path) -> _Series:
         row = int(np.flatnonzero(dt <= 0.0)[0]) + 2
         raise RunDirectoryError(f"{csv_path}: time_s is not increasing at data row {row}")
     return _Series(t, temp, per_step_mass, dt)
+
+
+def _series_until(series: _Series, until: float) -> _Series:
+    """The output times up to ``until`` (s), as a run stopped there would have written them."""
+    if not math.isfinite(until) or until < series.t[1] - _TIME_EPS_S:
+        raise AnalysisInputError(
+            "until", until, f"a simulated time >= {series.t[1]:.10g} s (the second output time, "
+            f"so that there is one step); the run ends at {series.t[-1]:.10g} s")
+    n = int(np.searchsorted(series.t, until + _TIME_EPS_S, side="right"))
+    return _Series(series.t[:n], series.temp[:n], series.per_step_mass[: n - 1], series.dt[: n - 1])
 
 
 @dataclass(frozen=True)

@@ -1,0 +1,769 @@
+"""Time to answer: what a run stopped at each earlier time would have reported (issue 11).
+
+How to use::
+
+    drumflow answer RUN_DIR                  # writes RUN_DIR/post/answer.csv, .json, .png
+    drumflow answer RUN_DIR --tolerance 0.02 --out /tmp/answer
+
+    from drumflow.bench.answer import replay_answer, write_answer
+    replay = replay_answer(Path("results/paper/model_two"))   # AnswerReplay
+    replay.table[["time_s", "h_W_m2K", "rel_h", "converged"]]
+    replay.first_fire_s, replay.settled_s
+
+The answer of a run is three numbers: (a) the mean particle temperature at 3.5 s (Tables 3-4 of
+the paper), (b) the falling mass flow over the window from ``run.mass_flow_start`` (Table 6)
+and (c) the paper's ``h`` (Eq. 39, :func:`drumflow.analysis.methodology.analyse_run`'s
+``h_mean``). The speed of a run is the wall time until its answer is known within 1 % of what
+the full run gives. This module replays a post-processed run (a run directory, or a shipped
+results folder with the same ``case.toml`` and ``post/`` files) at a grid of end times ``t``
+(every ``check_interval_s`` of simulated time, snapped to the output times):
+
+* (b) and (c) come from :func:`~drumflow.analysis.methodology.analyse_run` with ``until=t``:
+  the methodology on the truncated series, so the falling-mass window is
+  ``[mass_flow_start, t]``. As in the methodology, ``h`` averages every valid step from the
+  start of the run (Section 2.2), only the falling mass is measured in the window; the
+  column ``h_window_W_m2K`` gives the average over the window's steps alone. Their
+  half-widths are batch means (:func:`drumflow.convergence.batch_means`) of the per-step
+  series: ``h`` per step, and falling mass per step over its length. The falling mass cancels
+  from Eq. 39 but for the air's warming (:func:`drumflow.analysis.paper.eq39_as_lumped_h`), so
+  the uncertainty of (b) hardly enters (c).
+* (a) is read from the series (:func:`drumflow.analysis.paper.temperature_at`) once ``t``
+  reaches 3.5 s. Before that it is extrapolated with the lumped balance
+  ``T(3.5) = T_air + (T(t) - T_air) exp(-h_s A (3.5 - t) / (M c_p))``, where ``h_s`` is the
+  stop rule's whole-surface coefficient averaged over the window so far (exact while ``h_s``
+  stays constant; ``temperature_extrapolated`` marks these rows). Relative differences of a
+  temperature in deg C are small by construction (the paper's Tables 3-4 use them too);
+  ``rel_temperature_drop`` measures the drop ``T(0) - T(3.5)`` instead.
+* the verdict of ``run.stop = "converged"`` at ``t``: :func:`drumflow.convergence.convergence_state`
+  on the two series the online monitor builds (:meth:`drumflow.coupling.stop.StopMonitor.windowed`):
+  ``h`` on the whole particle surface per coupling update from ``post/air_heat.csv`` and the
+  mean temperature (:func:`drumflow.analysis.paper.coupling_h`), and the falling mass flow from
+  the crossings (``post/crossings.csv``) counted between consecutive updates. Besides the grid,
+  the rule is checked the way the loop checks it (every output step) to find its first firing.
+
+The reference is the longest time available, the last output time of
+``post/mean_temperature.csv`` (:attr:`AnswerReplay.reference_time_s`): for a run still going it
+is not the planned ``run.time``. Relative differences are ``value(t) / value(reference) - 1``;
+the settled time of a quantity is the first grid time from which it stays within
+``settle_tolerance`` of the reference.
+
+Wall time at ``t``: the sum over the coupling updates before ``t`` of the slowest rank's
+``python_wall_s + liggghts_wall_s`` from the run's coupling logs (``dem/coupling/rank*.csv``).
+An update without them (an older attempt, a shipped folder without ``dem/``) is estimated from a
+particle-steps-per-second rate: the one given, else the measured updates' own, else the run's
+``run_record.json`` (LIGGGHTS loop time of the shipped run). Set-up, the air solve and
+post-processing are not counted.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+from numpy.typing import NDArray
+
+from drumflow.analysis.methodology import (
+    FallingMassMode,
+    MethodologyResult,
+    analyse_run,
+)
+from drumflow.analysis.observables import falling_mass_flow
+from drumflow.analysis.paper import coupling_h, temperature_at
+from drumflow.case import Case
+from drumflow.convergence import ConvergenceState, batch_means, convergence_state
+from drumflow.coupling.log import WALL_COLUMNS, read_coupling
+from drumflow.coupling.stop import StopMonitor, min_stop_time
+from drumflow.errors import (
+    AnalysisInputError,
+    MissingRunFileError,
+    NoHeatTransferError,
+    RunDirectoryError,
+    RunTooShortError,
+)
+from drumflow.rundir import RunDir
+
+__all__ = [
+    "DEFAULT_CHECK_INTERVAL_S",
+    "DEFAULT_TOLERANCE",
+    "MIN_WINDOW_S",
+    "QUANTITIES",
+    "TEMPERATURE_TIME_S",
+    "AnswerReplay",
+    "plot_answer",
+    "replay_answer",
+    "settled_time",
+    "write_answer",
+]
+
+#: Largest relative difference from the full run at which the answer counts as known (issue 11).
+DEFAULT_TOLERANCE = 0.01
+#: Grid of end times, simulated seconds.
+DEFAULT_CHECK_INTERVAL_S = 0.1
+#: Tables 3-4 of the paper read the mean particle temperature at this time.
+TEMPERATURE_TIME_S = 3.5
+#: Least simulated time after ``run.mass_flow_start`` a run must hold to be replayed: below one
+#: second the falling mass flow has seen about one lifter's discharge (paper model two: 12
+#: lifters at 5 rpm, one per second).
+MIN_WINDOW_S = 1.0
+#: The answer's three quantities: column of the value, and its label.
+QUANTITIES = {"temperature": ("temperature_C", "(a) mean temperature at 3.5 s"),
+              "mass_flow": ("mass_flow_kg_s", "(b) falling mass flow"),
+              "h": ("h_W_m2K", "(c) h, Eq. 39")}
+
+# Output and update times are multiples of the DEM step (~1e-4 s) written with 10 significant
+# digits, a few 1e-9 s off at 17.5 s; 1e-6 s tells them apart from their neighbours safely.
+_TIME_EPS_S = 1e-6
+_RUN_RECORD = "run_record.json"
+
+
+@dataclass(frozen=True)
+class AnswerReplay:
+    """What a run stopped at each grid time would have reported, and when its answer settled.
+
+    Attributes
+    ----------
+    run_dir
+        The replayed directory (absolute).
+    case
+        Its case.
+    table
+        One row per grid time (the last row is the reference). Columns: ``time_s`` (the output
+        time a run stopped there ends at); ``temperature_C``, ``temperature_half_width_K``,
+        ``temperature_extrapolated``; ``mass_flow_kg_s``, ``mass_flow_half_width_kg_s``;
+        ``h_W_m2K``, ``h_half_width_W_m2K``, ``h_window_W_m2K``; ``eq57_mass_flow_kg_s`` (Eq. 57
+        from the crossings, first to last); the stop rule's ``monitor_h_W_m2K``,
+        ``monitor_h_rel_half_width``, ``monitor_mass_flow_kg_s``,
+        ``monitor_mass_flow_rel_half_width``, ``converged``, ``intervals_within_tolerance``
+        (the same verdict without the minimum time), ``reason``; ``rel_temperature``,
+        ``rel_temperature_drop``, ``rel_mass_flow``, ``rel_h``; ``wall_s`` (cumulative) and
+        ``wall_estimated_share`` (share of it from the rate, not measured).
+    reference_time_s
+        The end time the relative differences refer to: the last output time of the run.
+    planned_time_s
+        The case's ``run.time`` (the full run the answer is meant to match).
+    tolerance
+        The stop rule's tolerance (largest relative half-width).
+    settle_tolerance
+        Largest relative difference from the reference for "settled".
+    min_stop_time_s
+        The rule's minimum time (:func:`drumflow.coupling.stop.min_stop_time`).
+    check_every_steps
+        DEM steps between the rule's checks (the output step).
+    first_fire_s
+        First time the rule fires, checked as the coupling loop checks it; None if never.
+    first_fire_grid_s
+        First grid time at which it fires; None if never.
+    first_fire_reason
+        The verdict's line at ``first_fire_s`` (or at the reference when it never fires).
+    at_first_fire
+        Values and relative differences a run stopped at ``first_fire_s`` reports (empty if
+        the rule never fires).
+    settled_s
+        Per quantity (``temperature``, ``mass_flow``, ``h``, ``temperature_drop``): the first
+        grid time from which it stays within ``settle_tolerance``; None if not even the
+        reference qualifies.
+    wall
+        How the wall times were obtained: ``source`` (``measured``, ``rate``,
+        ``measured+rate``, or ``none``: no wall times and no rate, ``wall_s`` NaN),
+        ``particle_steps_per_s``, ``rate_source``, ``measured_updates``,
+        ``estimated_updates``, ``total_s`` (up to the reference).
+    notes
+        Remarks (the reference is not the planned end, the rule cannot fire yet, ...).
+    """
+
+    run_dir: Path
+    case: Case
+    table: pd.DataFrame
+    reference_time_s: float
+    planned_time_s: float
+    tolerance: float
+    settle_tolerance: float
+    min_stop_time_s: float
+    check_every_steps: int
+    first_fire_s: float | None
+    first_fire_grid_s: float | None
+    first_fire_reason: str
+    at_first_fire: dict[str, Any]
+    settled_s: dict[str, float | None]
+    wall: dict[str, Any]
+    notes: tuple[str, ...] = field(default=())
+
+    @property
+    def reference(self) -> pd.Series:
+        """The reference row of :attr:`table`."""
+        return self.table.iloc[-1]
+
+    @property
+    def answer_settled_s(self) -> float | None:
+        """When all three quantities (a), (b), (c) have settled; None if one never does."""
+        times = [self.settled_s[name] for name in QUANTITIES]
+        return None if any(t is None for t in times) else max(t for t in times if t is not None)
+
+    def wall_at(self, time_s: float | None) -> float | None:
+        """Cumulative wall time at a grid time, or at the first firing (None for None)."""
+        if time_s is None:
+            return None
+        if self.first_fire_s is not None and abs(time_s - self.first_fire_s) < _TIME_EPS_S:
+            return _finite_or_none(self.at_first_fire.get("wall_s"))
+        rows = self.table[np.abs(self.table["time_s"] - time_s) < _TIME_EPS_S]
+        return None if rows.empty else _finite_or_none(rows["wall_s"].iloc[0])
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready summary (NaN as ``null``); the per-time table is not included."""
+        ref = self.reference
+        values = {name: float(ref[col]) for name, (col, _) in QUANTITIES.items()}
+        half = {"temperature": float(ref["temperature_half_width_K"]),
+                "mass_flow": float(ref["mass_flow_half_width_kg_s"]),
+                "h": float(ref["h_half_width_W_m2K"])}
+        settled = self.answer_settled_s
+        return _json_safe({
+            "run_dir": str(self.run_dir),
+            "case": self.case.name,
+            "reference": {
+                "time_s": self.reference_time_s,
+                "source": "the longest time available: the last output time of "
+                          "post/mean_temperature.csv",
+                "planned_time_s": self.planned_time_s,
+                "values": values,
+                "half_widths": half,
+                "h_window_W_m2K": float(ref["h_window_W_m2K"]),
+                "eq57_mass_flow_kg_s": float(ref["eq57_mass_flow_kg_s"]),
+            },
+            "temperature_time_s": TEMPERATURE_TIME_S,
+            "settle_tolerance": self.settle_tolerance,
+            "settled_s": self.settled_s,
+            "answer_settled_s": settled,
+            "wall_at_answer_settled_s": self.wall_at(settled),
+            "rule": {
+                "tolerance": self.tolerance,
+                "min_time_s": self.min_stop_time_s,
+                "check_every_steps": self.check_every_steps,
+                "first_fire_s": self.first_fire_s,
+                "first_fire_grid_s": self.first_fire_grid_s,
+                "reason": self.first_fire_reason,
+                "wall_at_first_fire_s": self.wall_at(self.first_fire_s),
+                "at_first_fire": self.at_first_fire,
+            },
+            "wall": self.wall,
+            "grid_times": int(len(self.table)),
+            "notes": list(self.notes),
+        })
+
+
+def settled_time(times: Sequence[float] | NDArray[np.float64],
+                 relative_difference: Sequence[float] | NDArray[np.float64],
+                 tolerance: float) -> float | None:
+    """The first time from which ``|relative_difference| <= tolerance`` holds to the end.
+
+    Parameters
+    ----------
+    times
+        Increasing times.
+    relative_difference
+        The relative difference from the reference at each time (NaN: not known, so not
+        settled).
+    tolerance
+        Largest allowed ``|relative_difference|``.
+
+    Returns
+    -------
+    float or None
+        None when the last value itself is outside (or NaN).
+    """
+    t = np.asarray(times, dtype=float)
+    rel = np.abs(np.asarray(relative_difference, dtype=float))
+    ok = np.isfinite(rel) & (rel <= tolerance)
+    if t.size == 0 or not ok[-1]:
+        return None
+    bad = np.flatnonzero(~ok)
+    return float(t[0 if bad.size == 0 else bad[-1] + 1])
+
+
+# -- the replay -----------------------------------------------------------------------------
+def replay_answer(
+    run_dir: Path | str,
+    *,
+    tolerance: float = DEFAULT_TOLERANCE,
+    settle_tolerance: float = DEFAULT_TOLERANCE,
+    check_interval_s: float = DEFAULT_CHECK_INTERVAL_S,
+    times: Sequence[float] | None = None,
+    particle_steps_per_s: float | None = None,
+    falling_mass: FallingMassMode = "mean",
+) -> AnswerReplay:
+    """Replay a post-processed run: its answer and the stop rule's verdict at earlier end times.
+
+    Parameters
+    ----------
+    run_dir
+        A run directory after ``drumflow post``, or a shipped results folder of the same layout:
+        ``case.toml``, ``post/mean_temperature.csv``, ``post/air_heat.csv``,
+        ``post/crossings.csv``; optionally ``dem/coupling/rank*.csv`` (wall times) and
+        ``run_record.json`` (wall time of a shipped run).
+    tolerance
+        The stop rule's largest relative half-width (``run.stop_tolerance``).
+    settle_tolerance
+        Largest relative difference from the reference for "settled".
+    check_interval_s
+        Spacing of the grid of end times, simulated seconds, from ``run.mass_flow_start``;
+        each grid time is snapped to the last output time at or before it.
+    times
+        End times to use instead of the regular grid (each in
+        ``(run.mass_flow_start, end of the run]``); the end of the run is always added.
+    particle_steps_per_s
+        Rate for the updates whose wall time was not logged (default: see the module notes).
+    falling_mass
+        Passed to :func:`~drumflow.analysis.methodology.analyse_run`.
+
+    Returns
+    -------
+    AnswerReplay
+
+    Raises
+    ------
+    MissingRunFileError
+        A file the replay needs is missing (the message names it).
+    RunTooShortError
+        The run holds less than ``run.mass_flow_start + 1 s`` of simulated time.
+    AnalysisInputError
+        An argument is outside its allowed range (the message names it and the range).
+    RunDirectoryError
+        Not a run directory, or a file is malformed; also the errors of
+        :func:`~drumflow.analysis.methodology.analyse_run` on the whole run.
+    """
+    for name, value in (("tolerance", tolerance), ("settle_tolerance", settle_tolerance)):
+        if not (math.isfinite(value) and 0.0 < value < 1.0):
+            raise AnalysisInputError(name, value, "a relative tolerance in (0, 1), e.g. 0.01")
+    if not (math.isfinite(check_interval_s) and check_interval_s > 0.0):
+        raise AnalysisInputError("check_interval_s", check_interval_s,
+                                 "a positive number of simulated seconds, e.g. 0.1")
+    if particle_steps_per_s is not None and not (math.isfinite(particle_steps_per_s)
+                                                 and particle_steps_per_s > 0.0):
+        raise AnalysisInputError("particle_steps_per_s", particle_steps_per_s,
+                                 "a positive rate (particle-steps per wall second)")
+    run = RunDir.existing(run_dir)
+    for path, what in ((run.case_toml, "the validated case of the run"),
+                       (run.mean_temperature_csv, "mean particle temperature and falling mass "
+                        "per output step"),
+                       (run.air_heat_csv, "the coupling log: heat the air took per update"),
+                       (run.crossings_csv, "the particles crossing the axis plane")):
+        if not path.is_file():
+            raise MissingRunFileError(path, what)
+    # The whole run first: it validates the files and is the reference.
+    full = analyse_run(run.root, falling_mass=falling_mass)
+    case = full.case
+    temps = pd.read_csv(run.mean_temperature_csv)
+    out_t = temps["time_s"].to_numpy(float)
+    end = float(out_t[-1])
+    start = float(case.run.mass_flow_start)
+    if end < start + MIN_WINDOW_S - _TIME_EPS_S:
+        raise RunTooShortError(run.mean_temperature_csv, end, start + MIN_WINDOW_S,
+                               f"run.mass_flow_start = {start:g} s plus {MIN_WINDOW_S:g} s")
+    grid = _grid(out_t, start, check_interval_s, times)
+
+    updates, dt = _updates(case, run, temps, end)
+    crossings = pd.read_csv(run.crossings_csv)
+    if "time" not in crossings.columns:
+        raise RunDirectoryError(f"{run.crossings_csv}: no column 'time' (rerun `drumflow post DIR`)")
+    monitor = _monitor(case, run, updates, crossings, dt)
+    wall, wall_info = _wall_per_update(run, updates, dt, particle_steps_per_s)
+    notes: list[str] = []
+
+    min_time = min(min_stop_time(case), float(case.run.time))
+    rows = [_row(t, case, run, full if t >= end - _TIME_EPS_S else None, falling_mass, temps,
+                 crossings, updates, monitor, wall, tolerance, min_time, notes) for t in grid]
+    table = pd.DataFrame(rows)
+    ref = table.iloc[-1]
+    t0 = float(temps["mean_temperature_C"].iloc[0])
+    for name, (col, _) in QUANTITIES.items():
+        table[f"rel_{name}"] = table[col] / float(ref[col]) - 1.0
+    drop = t0 - table["temperature_C"]
+    table["rel_temperature_drop"] = drop / float(drop.iloc[-1]) - 1.0
+
+    every = _check_every(run, out_t, dt)
+    first_fire, reason = _first_fire(monitor, updates, out_t, every, tolerance, min_time)
+    fired = table.loc[table["converged"], "time_s"]
+    at_fire: dict[str, Any] = {}
+    if first_fire is not None:
+        fire_row = _row(first_fire, case, run, None, falling_mass, temps, crossings, updates,
+                        monitor, wall, tolerance, min_time, [])
+        at_fire = {key: fire_row[key] for key in
+                   ("time_s", "temperature_C", "mass_flow_kg_s", "h_W_m2K", "wall_s")}
+        for name, (col, _) in QUANTITIES.items():
+            at_fire[f"rel_{name}"] = float(fire_row[col]) / float(ref[col]) - 1.0
+    settled = {name: settled_time(table["time_s"], table[f"rel_{name}"], settle_tolerance)
+               for name in (*QUANTITIES, "temperature_drop")}
+
+    wall_info["total_s"] = float(table["wall_s"].iloc[-1])
+    planned = float(case.run.time)
+    late = float(grid[-2]) if grid.size > 1 else end
+    for name, when in settled.items():
+        if when is None or when >= late - _TIME_EPS_S:
+            notes.append(f"{name} settles only at the end of the replay ({late:.4g} s or later): "
+                         "it still drifts, so the run is too short to tell its answer")
+    if end < planned - _TIME_EPS_S:
+        notes.append(f"the reference is the run's last output at {end:.4g} s, not the planned "
+                     f"run.time = {planned:g} s: settled times are relative to it")
+    if end < min_time - _TIME_EPS_S:
+        notes.append(f"the rule cannot fire before its minimum time {min_time:.4g} s "
+                     f"(run.stop_min_time = {case.run.stop_min_time!r}); the run ends at "
+                     f"{end:.4g} s")
+    if end < TEMPERATURE_TIME_S - _TIME_EPS_S:
+        notes.append(f"the run ends before {TEMPERATURE_TIME_S:g} s: (a) is extrapolated at "
+                     "every time, the reference too")
+    if table["temperature_extrapolated"].any():
+        notes.append(f"(a) before {TEMPERATURE_TIME_S:g} s is extrapolated with the whole-surface "
+                     "h of the window so far (temperature_extrapolated)")
+    return AnswerReplay(
+        run_dir=run.root, case=case, table=table, reference_time_s=end, planned_time_s=planned,
+        tolerance=tolerance, settle_tolerance=settle_tolerance, min_stop_time_s=min_time,
+        check_every_steps=every,
+        first_fire_s=first_fire,
+        first_fire_grid_s=None if fired.empty else float(fired.iloc[0]),
+        first_fire_reason=reason, at_first_fire=at_fire, settled_s=settled, wall=wall_info,
+        notes=_merge_no_h(notes),
+    )
+
+
+def _grid(out_t: NDArray[np.float64], start: float, every: float,
+          times: Sequence[float] | None) -> NDArray[np.float64]:
+    """End times, snapped to the last output time at or before each; the run's end last."""
+    end = float(out_t[-1])
+    if times is None:
+        n = int(math.floor((end - start) / every + 1e-9))
+        targets = start + every * np.arange(1, n + 1)
+    else:
+        targets = np.asarray(list(times), dtype=float)
+        bad = targets[~np.isfinite(targets) | (targets <= start) | (targets > end + _TIME_EPS_S)]
+        if bad.size:
+            raise AnalysisInputError("times", float(bad[0]),
+                                     f"end times in ({start:g}, {end:.10g}] s "
+                                     "(after run.mass_flow_start, up to the end of the run)")
+    at = np.searchsorted(out_t, targets + _TIME_EPS_S, side="right") - 1
+    snapped = out_t[at[at >= 0]]
+    snapped = snapped[snapped > start + _TIME_EPS_S]
+    return np.unique(np.concatenate([snapped, [end]]))
+
+
+def _updates(case: Case, run: RunDir, temps: pd.DataFrame,
+             end: float) -> tuple[pd.DataFrame, float]:
+    """The coupling updates up to the end of the temperature series, with the whole-surface h
+    the stop rule uses (:func:`drumflow.analysis.paper.coupling_h`), and the DEM time step."""
+    air_heat = pd.read_csv(run.air_heat_csv)
+    try:
+        coupling = coupling_h(case, air_heat, temps)
+    except AnalysisInputError as exc:
+        raise RunDirectoryError(f"{run.air_heat_csv} with {run.mean_temperature_csv}: {exc}") from exc
+    table = air_heat[["step", "time_s", "steps"]].copy()
+    table["particles"] = air_heat["particles"] if "particles" in air_heat else case.particle_count
+    table["h_W_m2K"] = coupling.series["h_W_m2K"].to_numpy(float)
+    step = table["step"].to_numpy(float)
+    dt = float(np.median(table["time_s"].to_numpy(float)[step > 0] / step[step > 0]))
+    table["held_s"] = table["steps"].to_numpy(float) * dt
+    # A run stopped part way logged one update past its last output; it has no temperature.
+    return table[table["time_s"] <= end + _TIME_EPS_S].reset_index(drop=True), dt
+
+
+def _monitor(case: Case, run: RunDir, updates: pd.DataFrame, crossings: pd.DataFrame,
+             dt: float) -> StopMonitor:
+    """The online monitor, fed the replayed series instead of live particles.
+
+    It is made as a rank other than 0, which writes nothing, so the replay reads the run
+    directory only; :meth:`StopMonitor.windowed` then builds the rule's two series exactly as
+    the coupling loop does.
+    """
+    rule = {"tolerance": case.run.stop_tolerance, "min_time_s": min_stop_time(case),
+            "window_start_s": case.run.mass_flow_start, "check_every": 1,
+            "particle_mass_kg": case.particles.mass,
+            "air_temperature_C": case.air.inlet_temperature_C, "planned_time_s": case.run.time}
+    monitor = StopMonitor(rule, run.dem, rank=1, time_step=dt, start_step=0)
+    t_upd = updates["time_s"].to_numpy(float)
+    # Crossing sample k counts the crossings in (t_{k-1}, t_k], as the loop's tracker does.
+    at = np.searchsorted(t_upd, crossings["time"].to_numpy(float), side="left")
+    inside = (at > 0) & (at < t_upd.size)
+    counts = np.bincount(at[inside], minlength=t_upd.size).astype(float)
+    counts[0] = math.nan  # the first update has no previous sample
+    s = monitor.series
+    s.step = [int(v) for v in updates["step"]]
+    s.time_s = [float(v) for v in t_upd]
+    s.steps = [int(v) for v in updates["steps"]]
+    s.h = [float(v) for v in updates["h_W_m2K"]]
+    s.crossings = [float(v) for v in counts]
+    return monitor
+
+
+def _verdict(monitor: StopMonitor, n: int, time_s: float, tolerance: float,
+             min_time: float) -> tuple[ConvergenceState, bool]:
+    """The rule at ``time_s`` on the first ``n`` updates, and whether its intervals alone pass."""
+    full = monitor.series
+    monitor.series = replace(full, step=full.step[:n], time_s=full.time_s[:n],
+                             steps=full.steps[:n], h=full.h[:n], crossings=full.crossings[:n])
+    try:
+        series = monitor.windowed()
+    finally:
+        monitor.series = full
+    state = convergence_state(series, time_s, tolerance, min_time)
+    narrow = convergence_state(series, time_s, tolerance, -math.inf).converged
+    return state, narrow
+
+
+def _check_every(run: RunDir, out_t: NDArray[np.float64], dt: float) -> int:
+    """DEM steps between the rule's checks: the output step (``drumflow.dem.stage``)."""
+    recorded = run.manifest.get("output_every")
+    if recorded:
+        return int(recorded)
+    return max(1, int(round(float(np.median(np.diff(out_t))) / dt)))
+
+
+def _first_fire(monitor: StopMonitor, updates: pd.DataFrame, out_t: NDArray[np.float64],
+                every: int, tolerance: float, min_time: float) -> tuple[float | None, str]:
+    """The first check at which the rule fires, on the loop's schedule (an update whose step
+    is at least ``every`` after the previous check's), as the output time it stops at."""
+    steps = updates["step"].to_numpy(int)
+    t_upd = updates["time_s"].to_numpy(float)
+    last, state = 0, None
+    for i, step in enumerate(steps):
+        if step - last < every:
+            continue
+        last = int(step)
+        if t_upd[i] < min_time - _TIME_EPS_S:
+            continue
+        state, _ = _verdict(monitor, i + 1, float(t_upd[i]), tolerance, min_time)
+        if state.converged:
+            # The output written at that step (the same time, to its 10 digits).
+            near = int(np.argmin(np.abs(out_t - t_upd[i])))
+            return float(out_t[near] if abs(out_t[near] - t_upd[i]) < _TIME_EPS_S
+                         else t_upd[i]), state.reason
+    if state is None:
+        state, _ = _verdict(monitor, len(steps), float(t_upd[-1]), tolerance, min_time)
+    return None, f"never fired; at {state.time_s:.4g} s: {state.reason}"
+
+
+def _row(t: float, case: Case, run: RunDir, result: MethodologyResult | None,
+         falling_mass: FallingMassMode, temps: pd.DataFrame, crossings: pd.DataFrame,
+         updates: pd.DataFrame, monitor: StopMonitor, wall: NDArray[np.float64],
+         tolerance: float, min_time: float, notes: list[str]) -> dict[str, Any]:
+    """Everything a run stopped at ``t`` reports."""
+    start = float(case.run.mass_flow_start)
+    row: dict[str, Any] = {"time_s": t}
+    # (b), (c): the methodology on the series up to t.
+    if result is None:
+        try:
+            result = analyse_run(run.root, falling_mass=falling_mass, until=t)
+        except NoHeatTransferError as exc:
+            notes.append(f"no h at {t:.4g} s: {str(exc).split(': ', 1)[-1]}")
+    if result is None:
+        row.update(mass_flow_kg_s=math.nan, mass_flow_half_width_kg_s=math.nan, h_W_m2K=math.nan,
+                   h_half_width_W_m2K=math.nan, h_window_W_m2K=math.nan)
+    else:
+        steps = result.steps
+        valid = steps["valid"].to_numpy(bool)
+        dt_step = steps["dt_s"].to_numpy(float)
+        h = steps["h_W_m2K"].to_numpy(float)
+        window = steps["in_mass_flow_window"].to_numpy(bool)
+        in_h = valid & window
+        flow = batch_means(steps["falling_mass_in_step_kg"].to_numpy(float)[window] / dt_step[window],
+                           dt_step[window])
+        row.update(
+            mass_flow_kg_s=result.falling_mass_flow_kg_s,
+            mass_flow_half_width_kg_s=flow.half_width,
+            h_W_m2K=result.h_mean_w_m2k,
+            h_half_width_W_m2K=batch_means(h[valid], dt_step[valid]).half_width,
+            h_window_W_m2K=(float(np.sum(h[in_h] * dt_step[in_h]) / np.sum(dt_step[in_h]))
+                            if in_h.any() else math.nan),
+        )
+    upto = crossings[crossings["time"] <= t + _TIME_EPS_S]
+    eq57 = falling_mass_flow(upto, case.particles.mass, start=start)
+    row["eq57_mass_flow_kg_s"] = eq57.mass_flow_kg_s if eq57.crossings >= 2 else math.nan
+
+    # The stop rule on the updates up to t.
+    n = int(np.searchsorted(updates["time_s"].to_numpy(float), t + _TIME_EPS_S, side="right"))
+    state, narrow = _verdict(monitor, n, t, tolerance, min_time)
+    h_iv = state.intervals["h_W_m2K"]
+    m_iv = state.intervals["falling_mass_flow_kg_s"]
+    row.update(monitor_h_W_m2K=h_iv.mean, monitor_h_rel_half_width=h_iv.relative_half_width,
+               monitor_mass_flow_kg_s=m_iv.mean,
+               monitor_mass_flow_rel_half_width=m_iv.relative_half_width,
+               converged=state.converged, intervals_within_tolerance=narrow, reason=state.reason)
+
+    # (a): read at 3.5 s, or extrapolated with the window's whole-surface h.
+    times = temps["time_s"].to_numpy(float)
+    series = temps["mean_temperature_C"].to_numpy(float)
+    if t >= TEMPERATURE_TIME_S - 1e-9:  # temperature_at's own slack
+        row.update(temperature_C=temperature_at(times, series, TEMPERATURE_TIME_S),
+                   temperature_half_width_K=0.0, temperature_extrapolated=False)
+    else:
+        t_air = case.air.inlet_temperature_C
+        rate = (case.particle_count * math.pi * case.particles.diameter**2
+                / (case.particle_mass_total * case.particles.heat_capacity))  # 1/(s W/(m2 K))
+        lead = TEMPERATURE_TIME_S - t
+        excess = (float(np.interp(t, times, series)) - t_air) * math.exp(-h_iv.mean * rate * lead)
+        row.update(temperature_C=t_air + excess,
+                   temperature_half_width_K=abs(excess) * rate * lead * h_iv.half_width,
+                   temperature_extrapolated=True)
+    # Wall time of the updates that ended by t.
+    done = (updates["time_s"].to_numpy(float) + updates["held_s"].to_numpy(float)
+            <= t + _TIME_EPS_S)
+    row["wall_s"] = float(np.sum(wall[done, 0] + wall[done, 1]))
+    row["wall_estimated_share"] = (float(np.sum(wall[done, 1]) / row["wall_s"])
+                                   if row["wall_s"] > 0 else math.nan)
+    return row
+
+
+def _wall_per_update(run: RunDir, updates: pd.DataFrame, dt: float,
+                     rate: float | None) -> tuple[NDArray[np.float64], dict[str, Any]]:
+    """Per update: measured wall seconds (column 0) and estimated ones (column 1), one of them
+    zero; and how they were obtained."""
+    measured = np.full(len(updates), math.nan)
+    logged = pd.DataFrame()
+    folder = run.dem_coupling_logs
+    if folder.is_dir() and any(folder.glob("rank*.csv")):
+        logs = read_coupling(folder, dt)
+        if set(WALL_COLUMNS) <= set(logs.columns):
+            logs = logs.assign(wall_s=logs["python_wall_s"] + logs["liggghts_wall_s"])
+            # The logs may reach past the post-processed series (a run still going): every
+            # logged update gives the rate, those in the series their own wall time.
+            logged = logs[np.isfinite(logs["wall_s"])]
+            per_step = dict(zip(logged["step"].to_numpy(int), logged["wall_s"].to_numpy(float),
+                                strict=True))
+            measured = np.array([per_step.get(int(s), math.nan) for s in updates["step"]])
+    work = updates["particles"].to_numpy(float) * updates["steps"].to_numpy(float)
+    have = np.isfinite(measured)
+    rate_source = "argument particle_steps_per_s"
+    if rate is None and not logged.empty:
+        rate = float((logged["particles"] * logged["steps"]).sum() / logged["wall_s"].sum())
+        rate_source = (f"the {len(logged)} coupling updates with logged wall times "
+                       f"({float(logged['time_s'].min()):.4g}-{float(logged['time_s'].max()):.4g} s "
+                       "simulated): the speed of the code that ran them")
+    if rate is None:
+        rate, rate_source = _rate_from_record(run, updates)
+    estimated = np.where(have, 0.0, work / rate if rate else math.nan)
+    wall = np.column_stack([np.where(have, measured, 0.0), estimated])
+    source = ("measured" if have.all() else "none" if rate is None
+              else "rate" if not have.any() else "measured+rate")
+    info: dict[str, Any] = {
+        "source": source, "particle_steps_per_s": rate,
+        "rate_source": rate_source if not have.all() else "not used",
+        "measured_updates": int(have.sum()), "estimated_updates": int((~have).sum()),
+        "logged_updates_with_wall_times": len(logged),
+        "counts": "python_wall_s + liggghts_wall_s of the slowest rank per coupling update; "
+                  "no set-up, air solve or post-processing"}
+    if not logged.empty:
+        info["logged_wall_s_per_simulated_s"] = (float(logged["wall_s"].sum())
+                                                 / (float(logged["steps"].sum()) * dt))
+    return wall, info
+
+
+def _rate_from_record(run: RunDir, updates: pd.DataFrame) -> tuple[float | None, str]:
+    """Particle-steps per wall second of a shipped run, from its ``run_record.json``."""
+    path = run.root / _RUN_RECORD
+    if not path.is_file():
+        return None, "none: no wall times logged and no run_record.json"
+    record = json.loads(path.read_text())
+    wall = record.get("dem_wall_time_s")
+    simulated = record.get("simulated_time_s")
+    if not wall or not simulated:
+        return None, f"none: {path.name} has no dem_wall_time_s"
+    t_upd = updates["time_s"].to_numpy(float)
+    done = t_upd < float(simulated) - _TIME_EPS_S
+    work = float(np.sum(updates["particles"].to_numpy(float)[done]
+                        * updates["steps"].to_numpy(float)[done]))
+    return work / float(wall), (f"{path.name}: dem_wall_time_s = {float(wall):.6g} s over "
+                                f"{float(simulated):.4g} s simulated "
+                                f"({record.get('dem_wall_time_source', 'DEM wall time')})")
+
+
+def _merge_no_h(notes: list[str]) -> tuple[str, ...]:
+    """One note for the early times without h (they give the same reason), then the rest."""
+    early = [n for n in notes if n.startswith("no h at ")]
+    rest = [n for n in notes if not n.startswith("no h at ")]
+    if early:
+        times = ", ".join(n.split(" ")[3] for n in early)
+        rest.insert(0, f"no h at {times} s (the methodology raised NoHeatTransferError; at the "
+                       f"first: {early[0].split(': ', 1)[-1]})")
+    return tuple(dict.fromkeys(rest))
+
+
+def _finite_or_none(value: Any) -> float | None:
+    try:
+        f = float(value)
+    except (TypeError, ValueError):
+        return None
+    return f if math.isfinite(f) else None
+
+
+def _json_safe(value: Any) -> Any:
+    # NaN is not JSON: write null.
+    if isinstance(value, dict):
+        return {str(k): _json_safe(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_json_safe(v) for v in value]
+    if isinstance(value, (bool, np.bool_)):
+        return bool(value)
+    if isinstance(value, (int, np.integer)):
+        return int(value)
+    if isinstance(value, (float, np.floating)):
+        return _finite_or_none(value)
+    return value
+
+
+# -- output ---------------------------------------------------------------------------------
+def plot_answer(replay: AnswerReplay, path: Path, title: str = "") -> None:
+    """|relative difference| from the reference of (a), (b), (c) against simulated time (log
+    axis), the settle band and the rule's first firing."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    table = replay.table
+    t = table["time_s"].to_numpy(float)
+    fig, ax = plt.subplots(figsize=(7.5, 4.4), dpi=120)
+    floor = 1e-6
+    for (name, (_, label)), colour in zip(QUANTITIES.items(), ("tab:red", "tab:blue", "tab:green"),
+                                         strict=True):
+        rel = np.abs(table[f"rel_{name}"].to_numpy(float))
+        # The reference is 0 by definition: drawn at the floor of the axis.
+        ax.plot(t, np.clip(rel, floor, None), marker=".", lw=1.3, color=colour, label=label)
+        when = replay.settled_s.get(name)
+        if when is not None:
+            ax.axvline(when, color=colour, lw=0.8, ls=":")
+    ax.axhspan(floor, replay.settle_tolerance, color="0.9", zorder=0,
+               label=f"within {replay.settle_tolerance:.0%} (settled times dotted)")
+    ax.axhline(replay.settle_tolerance, color="0.4", lw=0.8)
+    if replay.first_fire_s is not None:
+        ax.axvline(replay.first_fire_s, color="black", lw=1.4, ls="--",
+                   label=f"stop rule fires ({replay.tolerance:.0%}): {replay.first_fire_s:.3g} s")
+    else:
+        ax.plot([], [], color="black", ls="--",
+                label=f"stop rule ({replay.tolerance:.0%}) never fires by {replay.reference_time_s:.3g} s")
+    ax.axvline(replay.min_stop_time_s, color="0.5", lw=0.8, ls="-.",
+               label=f"rule's minimum time {replay.min_stop_time_s:.3g} s")
+    ax.set_yscale("log")
+    ax.set_ylim(floor, max(1.0, float(np.nanmax(np.abs(table[[f"rel_{n}" for n in QUANTITIES]]
+                                                             .to_numpy(float)))) * 1.5))
+    ax.set_xlabel("simulated time at which the run stops (s)")
+    ax.set_ylabel(f"|value / value at {replay.reference_time_s:.3g} s - 1|")
+    ax.set_title(title or f"{replay.case.name}: time to answer", fontsize=9)
+    ax.legend(fontsize=7, loc="upper right")
+    fig.tight_layout()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, bbox_inches="tight")
+    plt.close(fig)
+
+
+def write_answer(replay: AnswerReplay, folder: Path, title: str = "") -> dict[str, Path]:
+    """Write ``answer.csv`` (per end time), ``answer.json`` and ``answer.png`` into ``folder``
+    (created if missing); return their paths by name."""
+    folder.mkdir(parents=True, exist_ok=True)
+    paths = {"table": folder / "answer.csv", "summary": folder / "answer.json",
+             "plot": folder / "answer.png"}
+    replay.table.to_csv(paths["table"], index=False, float_format="%.10g")
+    paths["summary"].write_text(json.dumps(replay.to_dict(), indent=2, allow_nan=False) + "\n")
+    plot_answer(replay, paths["plot"], title)
+    return paths
