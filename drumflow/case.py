@@ -112,6 +112,13 @@ class Particles(_Section):
         description="half the particles start this much hotter than the other half "
         "(mean unchanged); 0 = uniform feed. Used by conduction checks.",
     )
+    coarse_grain: float = Field(
+        1.0, ge=1.0, le=4.0,
+        description="opt-in coarse-graining for sweeps: the DEM moves parcels of this many "
+        "particle diameters (count divided by its cube, same total mass) while the air's drag "
+        "and heat act on each parcel as on the particles it stands for (same per kilogram); "
+        "1 = every particle (default). See drumflow.case.Case.dem_case.",
+    )
 
     @model_validator(mode="after")
     def _count_or_fill(self) -> Particles:
@@ -323,6 +330,15 @@ class Case(_Section):
                 f"particles.diameter = {d} m: must be at most a quarter of drum.length "
                 f"({0.25 * self.drum.length:g} m) so that the section holds several layers"
             )
+        parcel = self.particles.coarse_grain * d
+        if self.particles.coarse_grain > 1.0 and (
+                parcel > 0.25 * self.drum.length or (lf.count > 0 and gap < 3.0 * parcel)):
+            limit = 0.25 * self.drum.length if lf.count == 0 else min(0.25 * self.drum.length, gap / 3.0)
+            problems.append(
+                f"particles.coarse_grain = {self.particles.coarse_grain}: parcels of {parcel:.4g} m "
+                f"must fit the section and pass between the lifters (at most {limit:.4g} m, i.e. "
+                f"coarse_grain up to {limit / d:.3g})"
+            )
         if self.particles.count is not None and problems == []:
             solids = self.particles.count * self.particles.volume
             drum_volume = math.pi * R**2 * self.drum.length
@@ -414,6 +430,32 @@ class Case(_Section):
     @property
     def particle_mass_total(self) -> float:
         return self.particle_count * self.particles.mass
+
+    def dem_case(self) -> Case:
+        """The case the DEM moves: itself, or with ``particles.coarse_grain = k > 1`` its parcels.
+
+        Parcels are spheres ``k`` times the particle diameter, ``count / k**3`` of them (same
+        total mass; a ``fill_fraction`` case keeps its fraction), with the particles' material
+        and contacts, and ``coarse_grain = 1`` (the view is an ordinary case of larger
+        particles: geometry, time step, deck, placement and the DEM's counts follow from it).
+        What keeps the physics per kilogram is the coupling loop: it computes the air's drag and
+        heat for a particle of the real diameter at the parcel's velocity and temperature and
+        gives the parcel ``k**3`` times that (:class:`drumflow.coupling.spec.CouplingSpec`
+        ``coarse_grain``), so acceleration and heating rate are the particles'. Not kept: the
+        contact mechanics (a parcel's collisions are those of a larger sphere: the bed's
+        packing in the lifters, the curtain's density) and contact conduction per kilogram,
+        which is what the error measurement of the fast-and-accurate bench is for.
+        """
+        k = self.particles.coarse_grain
+        if k == 1.0:
+            return self
+        data = self.model_dump(mode="json")
+        p = data["particles"]
+        p["diameter"] = self.particles.diameter * k
+        p["coarse_grain"] = 1.0
+        if self.particles.count is not None:
+            p["count"] = max(1, round(self.particles.count / k**3))
+        return Case.model_validate(data)
 
     def canonical_json(self) -> str:
         """The case as canonical JSON (sorted keys), the basis of its hash.

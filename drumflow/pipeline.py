@@ -98,20 +98,23 @@ def run_case(
     rundir.bind_case(case.canonical_json(), case.hash(), case_to_toml(case), force=force,
                      versions=runner.profile.software_versions())
     t0 = time.perf_counter()
-    shape = geometry.run(case, rundir, runner)
+    # What the DEM moves: the particles, or with particles.coarse_grain their parcels. Geometry,
+    # time step and DEM follow the parcels; the air and its coupling the real particles.
+    moved = case.dem_case()
+    shape = geometry.run(moved, rundir, runner)
     if progress:
         progress("geometry", 1.0, 1.0)
     # The one choice of the time step and the processes: the air coupling and the DEM stage
     # both use them.
-    choice, plan = plan_run(case, steps)
-    nprocs = runner.profile.processes_for(case)
+    choice, plan = plan_run(moved, steps)
+    nprocs = runner.profile.processes_for(moved)
     coupling = _air(case, rundir, runner, nprocs, plan.time_step, plan.dump_every, progress)
-    rundir.record("skips", skips(case, choice.mode, coupling is not None, shape.wall_motion, nprocs))
+    rundir.record("skips", skips(moved, choice.mode, coupling is not None, shape.wall_motion, nprocs))
     inputs = DemInputs(shape, choice, plan, processes=nprocs, coupling=coupling, steps=steps,
                        timeout=timeout, progress=progress)
-    result = dem.run(case, rundir, runner, inputs)
+    result = dem.run(moved, rundir, runner, inputs)
     if steps is not None:
-        return _short_run_summary(case, rundir, result, steps, t0)
+        return _short_run_summary(moved, rundir, result, steps, t0)
     summary = post_run(rundir.root, case=case)
     summary["wall_time_s"] = time.perf_counter() - t0
     summary["dem_wall_time_s"] = result.wall_time_s
@@ -164,6 +167,9 @@ def post_run(out: Path | str, case: Case | None = None) -> dict[str, Any]:
     rundir.require(rundir.case_toml, rundir.dem_dumps, rundir.dem_log)
     if case is None:
         case = load_case(rundir.case_toml)
+    user_case = case
+    # Counts, masses and sizes of what the DEM moved (parcels under coarse-graining).
+    case = case.dem_case()
     ts = rundir.manifest.get("time_step", {}).get("time_step")
     if ts is None:
         raise RunDirectoryError(f"{root}/manifest.json: no DEM time step recorded; rerun the case")
@@ -229,7 +235,9 @@ def post_run(out: Path | str, case: Case | None = None) -> dict[str, Any]:
     summary: dict[str, Any] = {
         "case": case.name,
         "status": "ok" if not problems else "failed: " + "; ".join(problems),
-        "case_hash": case.hash(),
+        "case_hash": user_case.hash(),
+        **({"coarse_grain": user_case.particles.coarse_grain}
+           if user_case.particles.coarse_grain != 1.0 else {}),
         "particles_initial": case.particle_count,
         "particles_final": final,
         "particles_escaped_through_walls": escaped,

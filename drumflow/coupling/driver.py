@@ -122,6 +122,27 @@ def profile_stride(interval: int, every_steps: int = PROFILE_EVERY_STEPS) -> int
     return max(1, round(every_steps / max(interval, 1)))
 
 
+def air_load(air_velocity: NDArray[np.float64], velocity: NDArray[np.float64],
+             temperature: NDArray[np.float64], sphere_diameter: NDArray[np.float64],
+             coarse_grain: float, air: AirState
+             ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """Drag (N, (n, 3)) and heat (W) on each DEM sphere, and the particle diameter behind them.
+
+    Without coarse-graining (``coarse_grain`` 1) a sphere is a particle. With ``k > 1`` each
+    sphere is a parcel of ``k**3`` particles of ``1/k`` its diameter: its drag and heat are
+    those of one such particle at the parcel's velocity and temperature, ``k**3`` times, so that
+    per kilogram (acceleration, heating rate) they are the particles' (``Case.dem_case``).
+    """
+    d = sphere_diameter / coarse_grain
+    force = drag_force(air_velocity, velocity, d, air)
+    heat = convective_heat(air_velocity, velocity, temperature, d, air)
+    if coarse_grain != 1.0:
+        per_parcel = coarse_grain**3
+        force *= per_parcel
+        heat *= per_parcel
+    return force, heat, d
+
+
 def run(spec_path: Path) -> int:
     """Run the coupled loop described by a JSON spec (written by
     :meth:`drumflow.coupling.spec.CouplingSpec.write_driver_file`)."""
@@ -145,6 +166,8 @@ def run(spec_path: Path) -> int:
 
     def clock(at_step: int) -> float:
         return origin_time + (at_step - origin_step) * dt
+
+    coarse_grain = float(spec.get("coarse_grain", 1.0))
 
     interval = int(spec["interval"])
     stride = profile_stride(interval, int(spec.get("profile_every_steps", PROFILE_EVERY_STEPS)))
@@ -178,20 +201,19 @@ def run(spec_path: Path) -> int:
             n = min(interval, total - step)
             x = lmp.atom_array("x")
             v = lmp.atom_array("v")
-            d = 2.0 * lmp.atom_vector("radius")
             T = lmp.fix_vector("Temp")
             u = air_velocity_at(field, x, clock(step), omega)
-            force = drag_force(u, v, d, air)
-            heat = convective_heat(u, v, T, d, air)
+            force, heat, d = air_load(u, v, T, 2.0 * lmp.atom_vector("radius"), coarse_grain, air)
             found = tracker.update(lmp, clock(step)) if tracker is not None else None
-            if monitor is not None and monitor.observe(step, n, heat, d, T,
+            # The monitor's surface is the particles' (k**3 spheres of diameter d per parcel).
+            if monitor is not None and monitor.observe(step, n, heat, d * coarse_grain**1.5, T,
                                                        lmp.atom_vector("rmass"), found):
                 # Before this update's heat is applied or logged: the heat log stays exactly
                 # what LIGGGHTS received.
                 stopped = True
                 break
-            for k, name in enumerate(DRAG_FIXES):
-                lmp.fix_vector(name)[:] = force[:, k]
+            for axis, name in enumerate(DRAG_FIXES):
+                lmp.fix_vector(name)[:] = force[:, axis]
             lmp.fix_vector("heatSource")[:] = heat
             slip = float(np.linalg.norm(u - v, axis=1).mean()) if len(v) else 0.0
             row = (step, clock(step), n, float(heat.sum()), *map(float, force.sum(axis=0)), len(v), slip)

@@ -48,6 +48,9 @@ class CouplingSpec:
         The air's state (one-way: the air keeps its inlet temperature).
     omega
         Rotation rate of the frame the field was solved in (0 for a uniform field), rad/s.
+    coarse_grain
+        ``particles.coarse_grain`` k: each DEM sphere is a parcel of k**3 particles of 1/k its
+        diameter, and receives k**3 times the drag and heat of one of them (1: no parcels).
     """
 
     field: dict[str, Any]
@@ -56,11 +59,13 @@ class CouplingSpec:
     temperature_C: float
     pressure_kPa: float
     omega: float
+    coarse_grain: float = 1.0
 
     @property
     def key(self) -> str:
         """What the DEM stage's result depends on from the coupling."""
-        return f":air={self.field_key}:every={self.interval}"
+        parcels = f":parcels={self.coarse_grain:.12g}" if self.coarse_grain != 1.0 else ""
+        return f":air={self.field_key}:every={self.interval}{parcels}"
 
     def driver_file(self, deck: str, log: str, total_steps: int, time_step: float,
                     tail: list[str]) -> dict[str, Any]:
@@ -89,6 +94,7 @@ class CouplingSpec:
             "field": self.field,
             "coupling_log": COUPLING_LOG_PATTERN,
             "tail": tail,
+            "coarse_grain": self.coarse_grain,
         }
 
     def write_driver_file(self, work: Path, deck: str, log: str, total_steps: int,
@@ -115,7 +121,11 @@ def coupling_interval(case: Case, time_step: float, dump_every: int) -> int:
 
 
 def build_coupling(case: Case, source: FieldSource, time_step: float, dump_every: int) -> CouplingSpec:
-    """The spec the DEM stage runs with, from the air stage's field and the DEM step plan."""
+    """The spec the DEM stage runs with, from the air stage's field and the DEM step plan.
+
+    ``case`` is the user's case (real particles, not :meth:`~drumflow.case.Case.dem_case`): the
+    'auto' interval follows the real particles' response to the air, which parcels keep.
+    """
     return CouplingSpec(
         field=source.field,
         field_key=source.key,
@@ -123,6 +133,7 @@ def build_coupling(case: Case, source: FieldSource, time_step: float, dump_every
         temperature_C=case.air.inlet_temperature_C,
         pressure_kPa=case.air.pressure_kPa,
         omega=source.omega,
+        coarse_grain=case.particles.coarse_grain,
     )
 
 
