@@ -64,13 +64,17 @@ def check(case_file: Annotated[Path, typer.Argument(help="case file (TOML)")]) -
 
     case = _load(case_file)
     refuse_unavailable(case)
-    choice = choose_time_step(case)
+    moved = case.dem_case()  # the parcels under particles.coarse_grain: they set the step
+    choice = choose_time_step(moved)
     table = Table(title=f"case {case.name}: valid", show_header=False)
     table.add_row("drum", f"D {case.drum.diameter:g} m, l {case.drum.length:g} m, {case.drum.rpm:g} rpm, "
                   f"tilt {case.drum.tilt_deg:g}°, Froude {case.drum.froude:.3f}")
     table.add_row("lifters", f"{case.lifters.count} × {case.lifters.profile}")
     table.add_row("particles", f"{case.particle_count:,} × {case.particles.diameter * 1e3:g} mm, "
                   f"{case.particle_mass_total:.4g} kg")
+    if moved is not case:
+        table.add_row("DEM parcels", f"{moved.particle_count:,} × {moved.particles.diameter * 1e3:g} mm "
+                      f"(coarse_grain {case.particles.coarse_grain:g}; drag and heat per kg kept)")
     table.add_row("time step", f"{choice.time_step:.3g} s ({choice.mode}; {choice.fraction_of_rayleigh:.0%} "
                   f"of Rayleigh {choice.rayleigh_time:.3g} s; "
                   f"{choice.steps_per_contact:.0f} steps per contact)")
