@@ -589,6 +589,14 @@ def _record_table(run: PaperRun) -> _Table:
     if run.case is not None:
         rows.insert(0, ["case", f"{run.case.name}: {run.case.particle_count:,} particles of "
                         f"{run.case.particles.diameter * 1e3:g} mm, section {run.case.drum.length:g} m"])
+        moved = run.case.dem_case()
+        if moved is not run.case:
+            # A coarse-grained run answers a sweep's question, not the paper's at 1 %: say so.
+            rows.insert(1, ["coarse-grained (particles.coarse_grain)",
+                            f"the DEM moved {moved.particle_count:,} parcels of "
+                            f"{moved.particles.diameter * 1e3:g} mm ({run.case.particles.coarse_grain:g} "
+                            "particle diameters), drag and heat per kg kept; on model two parcels of 2 "
+                            "diameters kept the heat answer to 0.3 % and the falling mass flow to about 3 %"])
     return _Table(f"Model {run.model}: the run", ["quantity", "value"], rows)
 
 

@@ -319,3 +319,15 @@ def test_dem_wall_time_of_a_resumed_run_is_its_loop_time_not_a_file_time_span(
     record = run_record(root)
     assert record["dem_wall_time_s"] == pytest.approx(200.000004)
     assert "loop time" in record["dem_wall_time_source"]
+
+
+def test_page_says_when_a_model_was_coarse_grained(
+        tmp_path: Path, write_synthetic_run: Callable[..., Any],
+        synthetic_case_dict: Callable[..., dict[str, Any]]) -> None:
+    case = synthetic_case_dict(particles={"coarse_grain": 1.5})
+    write_synthetic_run(tmp_path / "model_two", case_dict=case)
+    run = collect_paper_run(tmp_path / "model_two", "two", render_3d=False)
+    assert run.case is not None and run.case.particles.coarse_grain == 1.5
+    html = write_paper([run], tmp_path / "out")["html"].read_text()
+    assert "coarse-grained (particles.coarse_grain)" in html
+    assert f"{run.case.dem_case().particle_count:,} parcels" in html
