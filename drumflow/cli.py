@@ -573,6 +573,12 @@ def answer(
         value = summary["reference"]["values"][name]
         console.print(f"{label} = {value:.6g}: within {tolerance:.0%} from "
                       f"{'never' if when is None else f'{when:.4g} s'}", highlight=False)
+    steady = replay.settled_s["steady_mass_flow"]
+    ref = summary["reference"]
+    console.print(f"falling mass flow of the cascading bed (window from "
+                  f"{ref['steady_start_s']:.3g} s, MSER) = {ref['steady_mass_flow_kg_s']:.6g}: within "
+                  f"{tolerance:.0%} from {'never' if steady is None else f'{steady:.4g} s'}",
+                  highlight=False)
     wall = replay.wall
     console.print(f"wall time: {wall['source']} (rate {wall['particle_steps_per_s'] or float('nan'):,.0f} "
                   f"particle-steps/s from {wall['rate_source']})", highlight=False)

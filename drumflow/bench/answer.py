@@ -76,7 +76,13 @@ from drumflow.analysis.methodology import (
 from drumflow.analysis.observables import falling_mass_flow
 from drumflow.analysis.paper import coupling_h, temperature_at
 from drumflow.case import Case
-from drumflow.convergence import ConvergenceState, batch_means, convergence_state
+from drumflow.convergence import (
+    MSER_BATCH,
+    ConvergenceState,
+    batch_means,
+    convergence_state,
+    mser_truncation,
+)
 from drumflow.coupling.log import WALL_COLUMNS, read_coupling
 from drumflow.coupling.stop import StopMonitor, min_stop_time
 from drumflow.errors import (
@@ -141,7 +147,10 @@ class AnswerReplay:
         ``monitor_h_rel_half_width``, ``monitor_mass_flow_kg_s``,
         ``monitor_mass_flow_rel_half_width``, ``converged``, ``intervals_within_tolerance``
         (the same verdict without the minimum time), ``reason``; ``rel_temperature``,
-        ``rel_temperature_drop``, ``rel_mass_flow``, ``rel_h``; ``wall_s`` (cumulative) and
+        ``rel_temperature_drop``, ``rel_mass_flow``, ``rel_h``; ``steady_mass_flow_kg_s``,
+        ``steady_mass_flow_half_width_kg_s``, ``steady_start_s`` (the falling mass flow from the
+        end of the start-up transient, :func:`_steady_mass_flow`) and
+        ``rel_steady_mass_flow``; ``wall_s`` (cumulative) and
         ``wall_estimated_share`` (share of it from the rate, not measured).
     reference_time_s
         The end time the relative differences refer to: the last output time of the run.
@@ -165,7 +174,8 @@ class AnswerReplay:
         Values and relative differences a run stopped at ``first_fire_s`` reports (empty if
         the rule never fires).
     settled_s
-        Per quantity (``temperature``, ``mass_flow``, ``h``, ``temperature_drop``): the first
+        Per quantity (``temperature``, ``mass_flow``, ``h``, ``temperature_drop``,
+        ``steady_mass_flow``: the cascading bed's flow after MSER's cut of the window): the first
         grid time from which it stays within ``settle_tolerance``; None if not even the
         reference qualifies.
     wall
@@ -234,6 +244,9 @@ class AnswerReplay:
                 "half_widths": half,
                 "h_window_W_m2K": float(ref["h_window_W_m2K"]),
                 "eq57_mass_flow_kg_s": float(ref["eq57_mass_flow_kg_s"]),
+                "steady_mass_flow_kg_s": float(ref["steady_mass_flow_kg_s"]),
+                "steady_mass_flow_half_width_kg_s": float(ref["steady_mass_flow_half_width_kg_s"]),
+                "steady_start_s": float(ref["steady_start_s"]),
             },
             "temperature_time_s": TEMPERATURE_TIME_S,
             "settle_tolerance": self.settle_tolerance,
@@ -384,6 +397,8 @@ def replay_answer(
         table[f"rel_{name}"] = table[col] / float(ref[col]) - 1.0
     drop = t0 - table["temperature_C"]
     table["rel_temperature_drop"] = drop / float(drop.iloc[-1]) - 1.0
+    table["rel_steady_mass_flow"] = (table["steady_mass_flow_kg_s"]
+                                     / float(ref["steady_mass_flow_kg_s"]) - 1.0)
 
     every = _check_every(run, out_t, dt)
     first_fire, reason = _first_fire(monitor, updates, out_t, every, tolerance, min_time)
@@ -397,7 +412,7 @@ def replay_answer(
         for name, (col, _) in QUANTITIES.items():
             at_fire[f"rel_{name}"] = float(fire_row[col]) / float(ref[col]) - 1.0
     settled = {name: settled_time(table["time_s"], table[f"rel_{name}"], settle_tolerance)
-               for name in (*QUANTITIES, "temperature_drop")}
+               for name in (*QUANTITIES, "temperature_drop", "steady_mass_flow")}
 
     wall_info["total_s"] = float(table["wall_s"].iloc[-1])
     planned = float(case.run.time)
@@ -479,7 +494,7 @@ def _monitor(case: Case, run: RunDir, updates: pd.DataFrame, crossings: pd.DataF
     """
     rule = {"tolerance": case.run.stop_tolerance, "min_time_s": min_stop_time(case),
             "window_start_s": case.run.mass_flow_start, "check_every": 1,
-            "particle_mass_kg": case.particles.mass,
+            "particle_mass_kg": case.dem_case().particles.mass,  # what crossed: parcels too
             "air_temperature_C": case.air.inlet_temperature_C, "planned_time_s": case.run.time}
     monitor = StopMonitor(rule, run.dem, rank=1, time_step=dt, start_step=0)
     t_upd = updates["time_s"].to_numpy(float)
@@ -578,8 +593,9 @@ def _row(t: float, case: Case, run: RunDir, result: MethodologyResult | None,
                             if in_h.any() else math.nan),
         )
     upto = crossings[crossings["time"] <= t + _TIME_EPS_S]
-    eq57 = falling_mass_flow(upto, case.particles.mass, start=start)
+    eq57 = falling_mass_flow(upto, case.dem_case().particles.mass, start=start)
     row["eq57_mass_flow_kg_s"] = eq57.mass_flow_kg_s if eq57.crossings >= 2 else math.nan
+    row.update(_steady_mass_flow(temps, start, t))
 
     # The stop rule on the updates up to t.
     n = int(np.searchsorted(updates["time_s"].to_numpy(float), t + _TIME_EPS_S, side="right"))
@@ -613,6 +629,30 @@ def _row(t: float, case: Case, run: RunDir, result: MethodologyResult | None,
     row["wall_estimated_share"] = (float(np.sum(wall[done, 1]) / row["wall_s"])
                                    if row["wall_s"] > 0 else math.nan)
     return row
+
+
+def _steady_mass_flow(temps: pd.DataFrame, start: float, t: float) -> dict[str, float]:
+    """The falling mass flow of the cascading bed: the window's per-output-step rate from the
+    end of its start-up transient (:func:`drumflow.convergence.mser_truncation`) to ``t``.
+
+    The paper's window opens at a fixed 1 s, while the flights are still filling for the first
+    time, so its average keeps rising with the run's length; the steady flow does not.
+    """
+    times = temps["time_s"].to_numpy(float)
+    mass = temps["falling_mass_kg_in_step"].to_numpy(float)
+    # Row k holds the mass fallen in (t_{k-1}, t_k]: in the window when that interval is.
+    inside = (np.r_[np.nan, times[:-1]] >= start - _TIME_EPS_S) & (times <= t + _TIME_EPS_S)
+    inside &= np.isfinite(mass)
+    gaps = np.r_[np.nan, np.diff(times)][inside]
+    rate = mass[inside] / gaps
+    if rate.size < 2 * MSER_BATCH:
+        return {"steady_mass_flow_kg_s": math.nan, "steady_mass_flow_half_width_kg_s": math.nan,
+                "steady_start_s": math.nan}
+    cut = mser_truncation(rate)
+    kept = rate[cut:]
+    return {"steady_mass_flow_kg_s": float(np.sum(kept * gaps[cut:]) / np.sum(gaps[cut:])),
+            "steady_mass_flow_half_width_kg_s": batch_means(kept, gaps[cut:]).half_width,
+            "steady_start_s": float(times[inside][cut] - gaps[cut])}
 
 
 def _wall_per_update(run: RunDir, updates: pd.DataFrame, dt: float,

@@ -157,3 +157,27 @@ def test_stop_rule_case_fields() -> None:
                                       run__stop_min_time=5.0))
     with pytest.raises(CaseError, match=r"run.stop_tolerance = 0.0"):
         case_from_dict(tiny_drum_dict(air__model="uniform", run__stop_tolerance=0.0))
+
+
+def test_mser_cuts_a_step_transient_where_it_ends() -> None:
+    from drumflow.convergence import mser_truncation
+
+    rng = np.random.default_rng(11)
+    x = rng.normal(0.0, 1.0, 2000)
+    x[:300] += 5.0  # a start-up offset of five standard deviations for 300 samples
+    d = mser_truncation(x)
+    assert 300 <= d <= 305  # the first whole batch of 5 after the step
+
+
+def test_mser_cuts_a_decaying_transient_and_little_of_a_stationary_series() -> None:
+    from drumflow.convergence import mser_truncation
+
+    rng = np.random.default_rng(12)
+    t = np.arange(2000)
+    noise = rng.normal(0.0, 1.0, t.size)
+    d = mser_truncation(10.0 * np.exp(-t / 50.0) + noise)
+    # The offset falls below the noise of a 5-sample batch mean (0.45) after 50 ln(10/0.45)
+    # = 155 samples; MSER stops between where it is a tenth and twice that.
+    assert 50 <= d <= 400
+    assert mser_truncation(noise) <= 200  # stationary: at most a tenth cut
+    assert mser_truncation(noise[:7]) == 0  # too short to batch twice
