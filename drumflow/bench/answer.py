@@ -773,6 +773,13 @@ def plot_answer(replay: AnswerReplay, path: Path, title: str = "") -> None:
         when = replay.settled_s.get(name)
         if when is not None:
             ax.axvline(when, color=colour, lw=0.8, ls=":")
+    steady = np.abs(table["rel_steady_mass_flow"].to_numpy(float))
+    if np.isfinite(steady).any():
+        ax.plot(t, np.clip(steady, floor, None), marker=".", lw=1.3, color="tab:purple",
+                label="(b') falling mass flow of the cascading bed (MSER window)")
+        when = replay.settled_s.get("steady_mass_flow")
+        if when is not None:
+            ax.axvline(when, color="tab:purple", lw=0.8, ls=":")
     ax.axhspan(floor, replay.settle_tolerance, color="0.9", zorder=0,
                label=f"within {replay.settle_tolerance:.0%} (settled times dotted)")
     ax.axhline(replay.settle_tolerance, color="0.4", lw=0.8)
