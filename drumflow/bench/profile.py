@@ -42,6 +42,7 @@ import numpy as np
 import pandas as pd
 
 from drumflow.coupling.log import WALL_COLUMNS, read_coupling
+from drumflow.dem.thermo import LOOP_TIME
 from drumflow.errors import RunDirectoryError
 from drumflow.rundir import RunDir
 
@@ -71,7 +72,7 @@ GROUPS = (*FIX_GROUPS, "other_fixes")
 #: Default width of the summary windows, simulated seconds.
 WINDOW_S = 0.5
 
-_LOOP = re.compile(r"^Loop time of (\S+) on (\d+) procs.*? for (\d+) steps with (\d+) atoms")
+_LOOP = LOOP_TIME
 _CATEGORY = re.compile(r"^(\w+)\s+time \(%\) = (\S+) \((\S+)\)")
 _FIX = re.compile(r"^Fix (\S+) (\S+) time \(%\) = (\S+) \((\S+)\)")
 _SCALARS = {

@@ -18,6 +18,16 @@ import pandas as pd
 COLUMNS = ("step", "time", "atoms", "ke", "ke_rot", "T_mean", "overlap_max", "cpu")
 #: Runs made before the overlap column existed (their logs stay readable by `drumflow post`).
 LEGACY_COLUMNS = ("step", "time", "atoms", "ke", "ke_rot", "T_mean", "cpu")
+#: LIGGGHTS' line after every ``run``: loop seconds, processes, steps, atoms. The one pattern
+#: for it (the profile and the run record both read it).
+LOOP_TIME = re.compile(r"^Loop time of (\S+) on (\d+) procs.*? for (\d+) steps with (\d+) atoms",
+                       flags=re.M)
+
+
+def loop_time_s(text: str) -> float | None:
+    """Sum of LIGGGHTS' loop times in a log's text (None when it has none)."""
+    times = [float(m.group(1)) for m in LOOP_TIME.finditer(text)]
+    return sum(times) if times else None
 
 
 class ThermoParser:

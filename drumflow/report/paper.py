@@ -137,15 +137,10 @@ def _loop_time_s(run: RunDir) -> float | None:
     count the hours between two sessions. Set-up, restart reading and the coupling loop's
     Python are not in it (``drumflow profile`` has them).
     """
-    import re
+    from drumflow.dem.thermo import loop_time_s
 
-    pattern = re.compile(r"^Loop time of (\S+) on ", flags=re.M)
-    total, found = 0.0, False
-    for log in run.dem_logs():
-        for m in pattern.finditer(log.read_text(errors="replace")):
-            total += float(m.group(1))
-            found = True
-    return total if found else None
+    found = [t for log in run.dem_logs() if (t := loop_time_s(log.read_text(errors="replace"))) is not None]
+    return sum(found) if found else None
 
 
 def _dump_span_s(run: RunDir) -> tuple[float, float] | None:
