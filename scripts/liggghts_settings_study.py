@@ -147,14 +147,20 @@ def _replace_line(deck: str, pattern: str, line: str) -> str:
     return new
 
 
+def _scale_value(deck: str, keyword: str, factor: float, fmt: str, suffix: str = "") -> str:
+    """The deck with the number after ``keyword`` (the one line ``keyword VALUE[suffix]``)
+    times ``factor``, written with ``fmt``."""
+    m = re.search(rf"^{keyword}\s+(\S+){suffix}\s*$", deck, flags=re.M)
+    if m is None:
+        raise StudyError(f"deck: no `{keyword} VALUE` line")
+    value = fmt.format(float(m.group(1)) * factor)
+    return _replace_line(deck, rf"^{keyword}\s+.*$", f"{keyword:<16}{value}")
+
+
 def apply_variant(deck: str, variant: Variant, ranks: int) -> str:
     """The baseline deck with the variant's settings."""
     if variant.skin_factor != 1.0:
-        m = re.search(r"^neighbor\s+(\S+)\s+bin\s*$", deck, flags=re.M)
-        if m is None:
-            raise StudyError("deck: no `neighbor SKIN bin` line")
-        skin = float(m.group(1)) * variant.skin_factor
-        deck = _replace_line(deck, r"^neighbor\s+.*$", f"neighbor        {skin:.6g} bin")
+        deck = _scale_value(deck, "neighbor", variant.skin_factor, "{:.6g} bin", suffix=r"\s+bin")
     if variant.neigh_modify is not None:
         deck = _replace_line(deck, r"^neigh_modify\s+.*$", f"neigh_modify    {variant.neigh_modify}")
     if variant.atom_modify is not None:
@@ -166,11 +172,7 @@ def apply_variant(deck: str, variant: Variant, ranks: int) -> str:
         deck = _replace_line(deck, r"^processors\s+.*$",
                              f"processors      {variant.processors.format(np=ranks)}")
     if variant.time_step_factor != 1.0:
-        m = re.search(r"^timestep\s+(\S+)\s*$", deck, flags=re.M)
-        if m is None:
-            raise StudyError("deck: no `timestep DT` line")
-        dt = float(m.group(1)) * variant.time_step_factor
-        deck = _replace_line(deck, r"^timestep\s+.*$", f"timestep        {dt:.12g}")
+        deck = _scale_value(deck, "timestep", variant.time_step_factor, "{:.12g}")
     if variant.moving_shell:
         pattern = (r"^fix shell all mesh/surface file (\S+) type 2 surface_ang_vel origin (\S+ \S+ \S+) "
                    r"axis (\S+ \S+ \S+) omega (\S+)\s*$")
