@@ -460,16 +460,18 @@ class Case(_Section):
     def canonical_json(self) -> str:
         """The case as canonical JSON (sorted keys), the basis of its hash.
 
-        A fixed-time run leaves out the 'converged' stop rule's fields, and a run with the
-        crossing dump its ``run.crossings``, so that cases written before these options existed
-        keep their hash (and their run directories and caches).
+        Options added after runs had been made are left out while they hold the value that
+        reproduces the old behaviour (:data:`_ADDED_LATER`), so that those runs keep their
+        hash, their run directories and their caches; a fixed-time run also leaves out the
+        'converged' rule's tolerances, which do nothing then.
         """
         data = self.model_dump(mode="json")
-        if data["run"]["stop"] == "fixed":
-            for name in ("stop", "stop_tolerance", "stop_min_time"):
+        for section, name, old_behaviour in _ADDED_LATER:
+            if data[section].get(name) == old_behaviour:
+                del data[section][name]
+        if "stop" not in data["run"]:
+            for name in ("stop_tolerance", "stop_min_time"):
                 del data["run"][name]
-        if data["run"]["crossings"] == "dump":
-            del data["run"]["crossings"]
         return json.dumps(data, sort_keys=True, separators=(",", ":"))
 
     def hash(self) -> str:
@@ -481,6 +483,17 @@ class Case(_Section):
         data = self.model_dump(mode="json")
         sub = {s: data[s] for s in sections}
         return hashlib.sha256(json.dumps(sub, sort_keys=True).encode()).hexdigest()
+
+
+#: Options that came after the first runs, each with the value that does what the code did
+#: before it existed: ``Case.canonical_json`` leaves them out at that value. Without this, a
+#: new option resets every run directory at ``drumflow run`` (a paper run of hours refused
+#: to resume when ``particles.coarse_grain`` arrived). Add each new option here.
+_ADDED_LATER: tuple[tuple[str, str, object], ...] = (
+    ("run", "stop", "fixed"),
+    ("run", "crossings", "dump"),
+    ("particles", "coarse_grain", 1.0),
+)
 
 
 def _format_error(err: dict[str, Any], loc: str) -> list[str]:
