@@ -296,6 +296,30 @@ def test_measured_wall_times_take_the_slowest_rank(tmp_path: Path) -> None:
                                rtol=1e-9)
     at4 = replay.table[np.isclose(replay.table["time_s"], 4.0)]
     assert at4["wall_estimated_share"].iloc[0] == pytest.approx(150 / 200)
+    assert replay.wall["paused_updates"] == 0
+
+
+def test_an_update_paused_from_outside_is_estimated_not_counted(tmp_path: Path) -> None:
+    """Regression: paper model two's log holds two updates of 8,388 s (the process was stopped
+    with SIGSTOP while a benchmark ran) among updates of 7-13 s; counted, they made the run
+    look 9 times slower than it was."""
+    h, counts = _inputs(seed=3)
+    root = _write_run(tmp_path / "run", h, counts)
+    logs = root / "dem" / "coupling"
+    logs.mkdir(parents=True)
+    steps = np.arange(0, N + 1) * STEPS
+    wall = np.full(len(steps), 1.0)
+    wall[100] = 5000.0  # stopped for 83 minutes in this update
+    pd.DataFrame({"step": steps, "time_s": steps * DT_DEM, "steps": STEPS,
+                  "heat_to_particles_W": -1.0, "drag_x_N": 0.0, "drag_y_N": 0.0,
+                  "drag_z_N": 0.0, "particles": 1500, "mean_slip_m_s": 3.0,
+                  "python_wall_s": 0.0, "liggghts_wall_s": wall}).to_csv(
+        logs / "rank0.0.csv", index=False)
+    replay = replay_answer(root, times=[4.0])
+    assert replay.wall["paused_updates"] == 1
+    assert replay.wall["particle_steps_per_s"] == pytest.approx(1500 * STEPS / 1.0)
+    # Every update one second: the paused one at the rate of the others.
+    np.testing.assert_allclose(replay.table["wall_s"], replay.table["time_s"] / DT, rtol=1e-9)
 
 
 # ------------------------------------------------------------------------------ the pieces
