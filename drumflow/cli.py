@@ -587,6 +587,51 @@ def answer(
     console.print("written: " + ", ".join(str(p) for p in paths.values()), highlight=False)
 
 
+@app.command()
+def ladder(
+    spec: Annotated[Path, typer.Argument(help="ladder spec (TOML): the rungs' runs, how each "
+                                         "stops, the reference")],
+    out: Annotated[
+        Path | None, typer.Option("--out", "-o", help="folder for ladder.csv, ladder.json and "
+                                  "ladder.png (default: the spec's folder)")
+    ] = None,
+    as_json: Annotated[bool, typer.Option("--json", help="print ladder.json instead of a table")] = False,
+) -> None:
+    """Time-to-answer ladder: wall time and errors of several runs of a scene against one
+    reference run (runs are replayed, not rerun)."""
+    from drumflow.bench.time_to_answer import SHORT_NAMES, answer_ladder, load_ladder_spec, write_ladder
+
+    result = answer_ladder(load_ladder_spec(spec))
+    paths = write_ladder(result, out or spec.parent)
+    if as_json:
+        console.print_json(json.dumps({**result.to_dict(),
+                                       "files": {k: str(v) for k, v in paths.items()}}))
+        return
+    answers = result.spec.answers
+    table = Table(title=f"{result.spec.title} (errors against '{result.spec.reference}'; "
+                  f"answer known within ±{result.spec.tolerance:.0%})", box=box.SIMPLE,
+                  padding=(0, 1))
+    for title in ("rung", "stop", "at s", "wall h", "faster",
+                  *(f"Δ {SHORT_NAMES[q]}" for q in answers), "known"):
+        table.add_column(title, justify="left" if title in ("rung", "stop") else "right")
+    for _, row in result.table.iterrows():
+        wall = row["wall_s"]
+        cells = [row["rung"], row["stop"],
+                 "never" if row["stop_time_s"] != row["stop_time_s"] else f"{row['stop_time_s']:.3g}",
+                 "-" if wall != wall else f"{wall / 3600:.2f}{'*' if row['wall_estimated'] else ''}",
+                 "-" if row["speedup"] != row["speedup"] else f"{row['speedup']:.2f}×",
+                 *(f"{row[f'error_{q}']:+.2%}" for q in answers),
+                 "yes" if row["within_tolerance"] else "no"]
+        table.add_row(*cells)
+    console.print(table)
+    floor = ", ".join(f"{q} ±{result.noise_floor[q]:.2%}" for q in answers)
+    console.print(f"noise floor (the reference's batch-means half-widths): {floor}; "
+                  "* wall time estimated (scaled or partly from a rate)", highlight=False)
+    for _, row in result.table.iterrows():
+        console.print(f"{row['rung']}: {row['note']}", highlight=False)
+    console.print("written: " + ", ".join(str(p) for p in paths.values()), highlight=False)
+
+
 # Last, after every command (and the groups above) is registered: one wrapper for all.
 guard_every_command(app)
 

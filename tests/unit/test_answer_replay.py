@@ -28,7 +28,24 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
-from support.synthetic_run import synthetic_case_dict
+from support.answer_run import (
+    COUNT,
+    DT,
+    DT_DEM,
+    H_ATOL,
+    MARGIN,
+    RUN_TIME,
+    SETTLE,
+    START,
+    STEPS,
+    T0,
+    T_AIR,
+    H,
+    N,
+    answer_case,
+    answer_inputs,
+    write_answer_run,
+)
 from typer.testing import CliRunner
 
 from drumflow.analysis.methodology import analyse_run
@@ -39,7 +56,6 @@ from drumflow.bench.answer import (
     settled_time,
     write_answer,
 )
-from drumflow.case import case_from_dict, case_to_toml
 from drumflow.cli import app
 from drumflow.convergence import convergence_state
 from drumflow.errors import (
@@ -51,87 +67,10 @@ from drumflow.errors import (
 ROOT = Path(__file__).resolve().parents[2]
 MODEL_TWO = ROOT / "results" / "paper" / "model_two"
 
-DT_DEM = 5e-4  # s, DEM step of the synthetic run
-STEPS = 40  # DEM steps per coupling update = per output step
-DT = DT_DEM * STEPS  # 0.02 s, the smoke case's dump_interval
-RUN_TIME = 6.0
-N = round(RUN_TIME / DT)  # output steps
-START = 1.0  # run.mass_flow_start
-T0, T_AIR = 90.0, 30.0
-H = 60.0  # W/(m2 K)
-# Before 0.8 s (outside the falling-mass window) the particles cool faster: the paper's h,
-# averaged from t = 0, then settles at 60 + 12.2 * 0.8 / t against its value at 6 s, within 1 %
-# from t = 4.35 s, halfway between two grid times (4.3 s: 1.04 %, 4.4 s: 0.96 %).
-H_EARLY, T_EARLY = 72.2, 0.8
-COUNT = 100  # crossings per output step
-SETTLE = 0.01
-# |expected relative difference| must stay this far from the 1 % threshold at every grid time,
-# so that the 6e-5 between the paper's h and h_k (module notes) cannot move a settled time.
-MARGIN = 2e-4
-H_ATOL = 1e-4
-
-
-def _case():  # type: ignore[no-untyped-def]
-    d = synthetic_case_dict(run={"time": RUN_TIME, "dump_interval": DT, "mass_flow_start": START})
-    return case_from_dict(d)
-
-
-def _write_run(root: Path, h: np.ndarray, counts: np.ndarray, *, steps: int = N) -> Path:
-    """A post-processed run with whole-surface ``h`` per update (``steps + 1`` values) and
-    ``counts`` crossings per output step (``steps`` values), in the shipped layout."""
-    h, counts = h[: steps + 1], counts[:steps]
-    case = _case()
-    area = case.particle_count * math.pi * case.particles.diameter**2
-    c = area / (case.particle_mass_total * case.particles.heat_capacity)
-    times = np.arange(steps + 1) * DT
-    temps = np.empty(steps + 1)
-    temps[0] = T0
-    for k in range(steps):
-        temps[k + 1] = T_AIR + (temps[k] - T_AIR) * (1.0 - h[k] * c * DT)
-    m_p = case.particles.mass
-    post = root / "post"
-    post.mkdir(parents=True)
-    (root / "case.toml").write_text(case_to_toml(case))
-    np.savetxt(post / "mean_temperature.csv",
-               np.column_stack([times, temps, np.full(steps + 1, case.particle_count),
-                                np.r_[np.nan, counts * m_p]]),
-               delimiter=",", header="time_s,mean_temperature_C,particles,falling_mass_kg_in_step",
-               comments="", fmt="%.10g")
-    heat = -h * area * (temps - T_AIR)  # W on the particles, held for the next STEPS steps
-    held = STEPS * DT_DEM
-    air = pd.DataFrame({"step": np.arange(steps + 1) * STEPS, "time_s": times, "steps": STEPS,
-                        "heat_to_particles_W": heat, "drag_x_N": 0.0, "drag_y_N": 0.0,
-                        "drag_z_N": 0.0, "particles": case.particle_count,
-                        "heat_removed_J": np.cumsum(-heat * held)})
-    air.to_csv(post / "air_heat.csv", index=False, float_format="%.10g")
-    rows = [(times[k] + (j + 0.5) * DT / counts[k], 1000 * k + j, 0.0, 0.04)
-            for k in range(steps) for j in range(int(counts[k]))]
-    pd.DataFrame(rows, columns=["time", "id", "x", "z"]).to_csv(
-        post / "crossings.csv", index=False, float_format="%.6g")
-    return root
-
-
-def _inputs(seed: int, late_step: bool = False) -> tuple[np.ndarray, np.ndarray]:
-    """``h`` per update and crossings per step: constant plus 0.3 % and +-3 noise, with the
-    early fast cooling, or (``late_step``) a step up of 10 % in h and 6 % in the crossings at
-    5 s."""
-    rng = np.random.default_rng(seed)
-    t = np.arange(N + 1) * DT
-    if late_step:
-        h = np.where(t < 5.0 - 1e-9, H, 1.1 * H)
-        counts = np.where(t[:-1] < 5.0 - 1e-9, COUNT, COUNT + 6)
-    else:
-        h = np.where(t < T_EARLY - 1e-9, H_EARLY, H)
-        counts = np.full(N, COUNT)
-    h = h * (1.0 + 0.003 * rng.standard_normal(N + 1))
-    counts = counts + rng.integers(-3, 4, N)
-    return h, counts
-
-
 def _expected(grid: np.ndarray, h: np.ndarray, counts: np.ndarray) -> dict[str, np.ndarray]:
     """The paper's h (as the time average of h_k from 0) and the window's mass flow at each
     grid time, relative to the last, computed from the inputs alone."""
-    m_p = _case().particles.mass
+    m_p = answer_case().particles.mass
     t_start = np.arange(N) * DT  # step k runs t_start[k] -> t_start[k] + DT
     rel_h, rel_m = [], []
     for t in grid:
@@ -148,7 +87,7 @@ def _expected_first_fire(h: np.ndarray, counts: np.ndarray, tolerance: float,
     """The rule's first firing, from the inputs: at every update, the h samples of the window
     and the crossing samples whose interval starts in it, as the coupling loop's monitor has
     them."""
-    m_p = _case().particles.mass
+    m_p = answer_case().particles.mass
     t = np.arange(N + 1) * DT
     for k in range(1, N + 1):
         if t[k] < min_time - 1e-9:
@@ -165,8 +104,8 @@ def _expected_first_fire(h: np.ndarray, counts: np.ndarray, tolerance: float,
 
 @pytest.fixture(scope="module")
 def steady(tmp_path_factory: pytest.TempPathFactory) -> tuple[AnswerReplay, np.ndarray, np.ndarray]:
-    h, counts = _inputs(seed=11)
-    root = _write_run(tmp_path_factory.mktemp("steady") / "run", h, counts)
+    h, counts = answer_inputs(seed=11)
+    root = write_answer_run(tmp_path_factory.mktemp("steady") / "run", h, counts)
     record = {"dem_wall_time_s": 600.0, "simulated_time_s": RUN_TIME,
               "dem_wall_time_source": "synthetic"}
     (root / "run_record.json").write_text(json.dumps(record))
@@ -175,8 +114,8 @@ def steady(tmp_path_factory: pytest.TempPathFactory) -> tuple[AnswerReplay, np.n
 
 @pytest.fixture(scope="module")
 def late(tmp_path_factory: pytest.TempPathFactory) -> tuple[AnswerReplay, np.ndarray, np.ndarray]:
-    h, counts = _inputs(seed=5, late_step=True)
-    root = _write_run(tmp_path_factory.mktemp("late") / "run", h, counts)
+    h, counts = answer_inputs(seed=5, late_step=True)
+    root = write_answer_run(tmp_path_factory.mktemp("late") / "run", h, counts)
     return replay_answer(root), h, counts
 
 
@@ -215,7 +154,7 @@ def test_settled_times_are_where_the_construction_puts_them(steady) -> None:  # 
 
 def test_temperature_at_3p5_is_read_then_extrapolated_exactly_for_constant_h(steady) -> None:  # type: ignore[no-untyped-def]
     replay, h, _ = steady
-    case = _case()
+    case = answer_case()
     c = case.particle_count * math.pi * case.particles.diameter**2 / (
         case.particle_mass_total * case.particles.heat_capacity)
     k_end = round(TEMPERATURE_TIME_S / DT)
@@ -274,8 +213,8 @@ def test_late_step_change_is_not_settled_before_it(late) -> None:  # type: ignor
 
 
 def test_measured_wall_times_take_the_slowest_rank(tmp_path: Path) -> None:
-    h, counts = _inputs(seed=3)
-    root = _write_run(tmp_path / "run", h, counts)
+    h, counts = answer_inputs(seed=3)
+    root = write_answer_run(tmp_path / "run", h, counts)
     logs = root / "dem" / "coupling"
     logs.mkdir(parents=True)
     # Logged from 3 s on (a resumed attempt); rank 1 is slower in Python, rank 0 in LIGGGHTS.
@@ -303,8 +242,8 @@ def test_an_update_paused_from_outside_is_estimated_not_counted(tmp_path: Path) 
     """Regression: paper model two's log holds two updates of 8,388 s (the process was stopped
     with SIGSTOP while a benchmark ran) among updates of 7-13 s; counted, they made the run
     look 9 times slower than it was."""
-    h, counts = _inputs(seed=3)
-    root = _write_run(tmp_path / "run", h, counts)
+    h, counts = answer_inputs(seed=3)
+    root = write_answer_run(tmp_path / "run", h, counts)
     logs = root / "dem" / "coupling"
     logs.mkdir(parents=True)
     steps = np.arange(0, N + 1) * STEPS
@@ -312,12 +251,12 @@ def test_an_update_paused_from_outside_is_estimated_not_counted(tmp_path: Path) 
     wall[100] = 5000.0  # stopped for 83 minutes in this update
     pd.DataFrame({"step": steps, "time_s": steps * DT_DEM, "steps": STEPS,
                   "heat_to_particles_W": -1.0, "drag_x_N": 0.0, "drag_y_N": 0.0,
-                  "drag_z_N": 0.0, "particles": 1500, "mean_slip_m_s": 3.0,
+                  "drag_z_N": 0.0, "particles": 3000, "mean_slip_m_s": 3.0,
                   "python_wall_s": 0.0, "liggghts_wall_s": wall}).to_csv(
         logs / "rank0.0.csv", index=False)
     replay = replay_answer(root, times=[4.0])
     assert replay.wall["paused_updates"] == 1
-    assert replay.wall["particle_steps_per_s"] == pytest.approx(1500 * STEPS / 1.0)
+    assert replay.wall["particle_steps_per_s"] == pytest.approx(3000 * STEPS / 1.0)
     # Every update one second: the paused one at the rate of the others.
     np.testing.assert_allclose(replay.table["wall_s"], replay.table["time_s"] / DT, rtol=1e-9)
 
@@ -334,9 +273,9 @@ def test_settled_time_is_the_start_of_the_last_run_inside() -> None:
 
 
 def test_until_equals_the_truncated_run(tmp_path: Path) -> None:
-    h, counts = _inputs(seed=2)
-    whole = _write_run(tmp_path / "whole", h, counts)
-    cut = _write_run(tmp_path / "cut", h, counts, steps=150)  # 3 s, same inputs
+    h, counts = answer_inputs(seed=2)
+    whole = write_answer_run(tmp_path / "whole", h, counts)
+    cut = write_answer_run(tmp_path / "cut", h, counts, steps=150)  # 3 s, same inputs
     a = analyse_run(whole, until=3.0)
     b = analyse_run(cut)
     assert a.n_steps == b.n_steps == 150
@@ -348,14 +287,14 @@ def test_until_equals_the_truncated_run(tmp_path: Path) -> None:
 
 
 def test_too_short_run_and_missing_file_are_named(tmp_path: Path) -> None:
-    h, counts = _inputs(seed=1)
-    short = _write_run(tmp_path / "short", h, counts, steps=90)  # 1.8 s < 1 s + 1 s
+    h, counts = answer_inputs(seed=1)
+    short = write_answer_run(tmp_path / "short", h, counts, steps=90)  # 1.8 s < 1 s + 1 s
     with pytest.raises(RunTooShortError, match=r"at least 2 s"):
         replay_answer(short)
     result = CliRunner().invoke(app, ["answer", str(short), "--out", str(tmp_path / "o")])
     assert result.exit_code == 2
     assert "at least 2 s" in " ".join(result.output.split())
-    whole = _write_run(tmp_path / "whole", h, counts, steps=120)
+    whole = write_answer_run(tmp_path / "whole", h, counts, steps=120)
     with pytest.raises(AnalysisInputError, match=r"times = 0.5 .*\(1, 2.4\] s"):
         replay_answer(whole, times=[0.5])
     (whole / "post" / "crossings.csv").unlink()
@@ -364,8 +303,8 @@ def test_too_short_run_and_missing_file_are_named(tmp_path: Path) -> None:
 
 
 def test_cli_writes_the_three_files(tmp_path: Path) -> None:
-    h, counts = _inputs(seed=4)
-    root = _write_run(tmp_path / "run", h, counts, steps=150)
+    h, counts = answer_inputs(seed=4)
+    root = write_answer_run(tmp_path / "run", h, counts, steps=150)
     out = tmp_path / "answer"
     result = CliRunner().invoke(app, ["answer", str(root), "--out", str(out), "--every", "0.5"])
     assert result.exit_code == 0, result.output
@@ -437,9 +376,9 @@ def test_steady_mass_flow_cuts_the_filling_the_paper_window_keeps(tmp_path: Path
     ramp = np.clip((t - START) / 1.5, 0.0, 1.0)
     counts = np.round(COUNT * ramp).astype(int) + rng.integers(-3, 4, N) * (ramp >= 1.0)
     h = np.full(N + 1, H)
-    replay = replay_answer(_write_run(tmp_path / "run", h, counts))
+    replay = replay_answer(write_answer_run(tmp_path / "run", h, counts))
     table = replay.table
-    steady_flow = COUNT * _case().particles.mass / DT
+    steady_flow = COUNT * answer_case().particles.mass / DT
     ref = table.iloc[-1]
     assert ref["steady_mass_flow_kg_s"] == pytest.approx(steady_flow, rel=0.005)
     # The cut lands where the ramp ends (within two MSER batches of 5 output steps).
