@@ -243,7 +243,8 @@ class Run(_Section):
     stop: Literal["fixed", "converged"] = Field(
         "fixed", description="'fixed': run for run.time; 'converged': end as soon as the air's "
         "heat-transfer coefficient and the falling mass flow are both known to run.stop_tolerance "
-        "(95% batch-means intervals, drumflow.convergence), at the latest at run.time"
+        "(95% intervals over whole lifter cycles after the start-up, drumflow.convergence), at the "
+        "latest at run.time"
     )
     stop_tolerance: float = Field(
         0.01, gt=0, le=0.5, description="'converged' stop: largest relative half-width of the "

@@ -34,8 +34,8 @@ results folder with the same ``case.toml`` and ``post/`` files) at a grid of end
   stays constant; ``temperature_extrapolated`` marks these rows). Relative differences of a
   temperature in deg C are small by construction (the paper's Tables 3-4 use them too);
   ``rel_temperature_drop`` measures the drop ``T(0) - T(3.5)`` instead.
-* the verdict of ``run.stop = "converged"`` at ``t``: :func:`drumflow.convergence.convergence_state`
-  on the two series the online monitor builds (:meth:`drumflow.coupling.stop.StopMonitor.windowed`):
+* the verdict of ``run.stop = "converged"`` at ``t``: :func:`drumflow.convergence.decide` on
+  the two intervals the online monitor forms (:meth:`drumflow.coupling.stop.StopMonitor.intervals`):
   ``h`` on the whole particle surface per coupling update from ``post/air_heat.csv`` and the
   mean temperature (:func:`drumflow.analysis.paper.coupling_h`), and the falling mass flow from
   the crossings (``post/crossings.csv``) counted between consecutive updates. Besides the grid,
@@ -80,12 +80,13 @@ from drumflow.case import Case
 from drumflow.convergence import (
     MSER_BATCH,
     ConvergenceState,
+    MeanInterval,
     batch_means,
-    convergence_state,
+    decide,
     mser_truncation,
 )
 from drumflow.coupling.log import WALL_COLUMNS, read_coupling
-from drumflow.coupling.stop import StopMonitor, min_stop_time
+from drumflow.coupling.stop import StopMonitor, min_stop_time, rule_inputs
 from drumflow.errors import (
     AnalysisInputError,
     MissingRunFileError,
@@ -498,10 +499,8 @@ def _monitor(case: Case, run: RunDir, updates: pd.DataFrame, crossings: pd.DataF
     directory only; :meth:`StopMonitor.windowed` then builds the rule's two series exactly as
     the coupling loop does.
     """
-    rule = {"tolerance": case.run.stop_tolerance, "min_time_s": min_stop_time(case),
-            "window_start_s": case.run.mass_flow_start, "check_every": 1,
-            "particle_mass_kg": case.dem_case().particles.mass,  # what crossed: parcels too
-            "air_temperature_C": case.air.inlet_temperature_C, "planned_time_s": case.run.time}
+    # The DEM's case: with coarse-graining, what crossed were parcels.
+    rule = rule_inputs(case.dem_case(), case.run.time, check_every=1)
     monitor = StopMonitor(rule, run.dem, rank=1, time_step=dt, start_step=0)
     t_upd = updates["time_s"].to_numpy(float)
     # Crossing sample k counts the crossings in (t_{k-1}, t_k], as the loop's tracker does.
@@ -519,18 +518,21 @@ def _monitor(case: Case, run: RunDir, updates: pd.DataFrame, crossings: pd.DataF
 
 
 def _verdict(monitor: StopMonitor, n: int, time_s: float, tolerance: float,
-             min_time: float) -> tuple[ConvergenceState, bool]:
-    """The rule at ``time_s`` on the first ``n`` updates, and whether its intervals alone pass."""
+             min_time: float) -> tuple[ConvergenceState, bool, MeanInterval]:
+    """The rule at ``time_s`` on the first ``n`` updates, whether its intervals alone pass, and
+    the whole-surface h over the window so far (batch means of every sample, whole cycles or
+    not: the temperature's extrapolation needs it before the first cycle ends)."""
     full = monitor.series
     monitor.series = replace(full, step=full.step[:n], time_s=full.time_s[:n],
                              steps=full.steps[:n], h=full.h[:n], crossings=full.crossings[:n])
     try:
-        series = monitor.windowed()
+        intervals = monitor.intervals()
+        h_window = batch_means(*monitor.windowed()["h_W_m2K"])
     finally:
         monitor.series = full
-    state = convergence_state(series, time_s, tolerance, min_time)
-    narrow = convergence_state(series, time_s, tolerance, -math.inf).converged
-    return state, narrow
+    state = decide(intervals, time_s, tolerance, min_time)
+    narrow = decide(intervals, time_s, tolerance, -math.inf).converged
+    return state, narrow, h_window
 
 
 def _check_every(run: RunDir, out_t: NDArray[np.float64], dt: float) -> int:
@@ -554,14 +556,14 @@ def _first_fire(monitor: StopMonitor, updates: pd.DataFrame, out_t: NDArray[np.f
         last = int(step)
         if t_upd[i] < min_time - _TIME_EPS_S:
             continue
-        state, _ = _verdict(monitor, i + 1, float(t_upd[i]), tolerance, min_time)
+        state, _, _ = _verdict(monitor, i + 1, float(t_upd[i]), tolerance, min_time)
         if state.converged:
             # The output written at that step (the same time, to its 10 digits).
             near = int(np.argmin(np.abs(out_t - t_upd[i])))
             return float(out_t[near] if abs(out_t[near] - t_upd[i]) < _TIME_EPS_S
                          else t_upd[i]), state.reason
     if state is None:
-        state, _ = _verdict(monitor, len(steps), float(t_upd[-1]), tolerance, min_time)
+        state, _, _ = _verdict(monitor, len(steps), float(t_upd[-1]), tolerance, min_time)
     return None, f"never fired; at {state.time_s:.4g} s: {state.reason}"
 
 
@@ -605,7 +607,7 @@ def _row(t: float, case: Case, run: RunDir, result: MethodologyResult | None,
 
     # The stop rule on the updates up to t.
     n = int(np.searchsorted(updates["time_s"].to_numpy(float), t + _TIME_EPS_S, side="right"))
-    state, narrow = _verdict(monitor, n, t, tolerance, min_time)
+    state, narrow, h_window = _verdict(monitor, n, t, tolerance, min_time)
     h_iv = state.intervals["h_W_m2K"]
     m_iv = state.intervals["falling_mass_flow_kg_s"]
     row.update(monitor_h_W_m2K=h_iv.mean, monitor_h_rel_half_width=h_iv.relative_half_width,
@@ -624,9 +626,9 @@ def _row(t: float, case: Case, run: RunDir, result: MethodologyResult | None,
         rate = (case.particle_count * math.pi * case.particles.diameter**2
                 / (case.particle_mass_total * case.particles.heat_capacity))  # 1/(s W/(m2 K))
         lead = TEMPERATURE_TIME_S - t
-        excess = (float(np.interp(t, times, series)) - t_air) * math.exp(-h_iv.mean * rate * lead)
+        excess = (float(np.interp(t, times, series)) - t_air) * math.exp(-h_window.mean * rate * lead)
         row.update(temperature_C=t_air + excess,
-                   temperature_half_width_K=abs(excess) * rate * lead * h_iv.half_width,
+                   temperature_half_width_K=abs(excess) * rate * lead * h_window.half_width,
                    temperature_extrapolated=True)
     # Wall time of the updates that ended by t.
     done = (updates["time_s"].to_numpy(float) + updates["held_s"].to_numpy(float)

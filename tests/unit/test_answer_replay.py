@@ -28,6 +28,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
+from scipy import stats
 from support.answer_run import (
     COUNT,
     DT,
@@ -57,7 +58,7 @@ from drumflow.bench.answer import (
     write_answer,
 )
 from drumflow.cli import app
-from drumflow.convergence import convergence_state
+from drumflow.convergence import mser_truncation
 from drumflow.errors import (
     AnalysisInputError,
     MissingRunFileError,
@@ -82,22 +83,40 @@ def _expected(grid: np.ndarray, h: np.ndarray, counts: np.ndarray) -> dict[str, 
     return {"h": h_t / h_t[-1] - 1.0, "mass_flow": m_t / m_t[-1] - 1.0, "mass_flow_value": m_t}
 
 
+def _cycle_interval(per_step: np.ndarray, t_now: float) -> tuple[float, bool]:
+    """Relative half-width of a series' mean from whole lifter cycles, by hand: the mean of each
+    cycle's output steps (step j, from t_j to t_j + DT, lies in the cycle of its midpoint);
+    MSER's cut once there are ten cycles; Student's t over what is left; NaN below five cycles.
+    Also whether the cycle means pass the lag-1 independence check."""
+    cycle = 60.0 / (answer_case().drum.rpm * answer_case().lifters.count)  # 0.5 s
+    per = round(cycle / DT)  # output steps per cycle
+    whole = int(np.floor((t_now - START) / cycle + 1e-9))
+    first = round(START / DT)
+    means = np.array([per_step[first + j * per: first + (j + 1) * per].mean() for j in range(whole)])
+    if means.size >= 10:
+        means = means[mser_truncation(means, batch=1):]
+    b = means.size
+    if b < 5:
+        return math.nan, False
+    half = stats.t.ppf(0.975, b - 1) * means.std(ddof=1) / math.sqrt(b)
+    dev = means - means.mean()
+    r1 = np.sum(dev[:-1] * dev[1:]) / np.sum(dev**2)
+    return half / abs(means.mean()), bool(r1 <= -1.0 / b + stats.norm.ppf(0.95) / math.sqrt(b))
+
+
 def _expected_first_fire(h: np.ndarray, counts: np.ndarray, tolerance: float,
                          min_time: float) -> float | None:
-    """The rule's first firing, from the inputs: at every update, the h samples of the window
-    and the crossing samples whose interval starts in it, as the coupling loop's monitor has
-    them."""
+    """The rule's first firing, from the inputs: at every update, the whole lifter cycles of
+    h (each update's h held to the next) and of the crossings, by hand (:func:`_cycle_interval`)."""
     m_p = answer_case().particles.mass
     t = np.arange(N + 1) * DT
     for k in range(1, N + 1):
         if t[k] < min_time - 1e-9:
             continue
-        in_h = (t[: k + 1] >= START - 1e-9)
-        c_t = t[1: k + 1]
-        in_c = c_t - DT >= START - 1e-9
-        series = {"h_W_m2K": (h[: k + 1][in_h], np.full(in_h.sum(), DT)),
-                  "falling_mass_flow_kg_s": (counts[:k][in_c] * m_p / DT, np.full(in_c.sum(), DT))}
-        if convergence_state(series, float(t[k]), tolerance, min_time).converged:
+        # h sample k is held from t_k to t_k + DT: at t_k the cycles that end by t_k + DT count.
+        h_rel, h_independent = _cycle_interval(h[: k + 1], float(t[k]) + DT)
+        flow_rel, flow_independent = _cycle_interval(counts[:k] * m_p / DT, float(t[k]))
+        if h_independent and h_rel <= tolerance and flow_independent and flow_rel <= tolerance:
             return float(t[k])
     return None
 
