@@ -175,6 +175,13 @@ class RunDir:
         return self.post / "crossings.csv"
 
     @property
+    def crossings_table(self) -> Path:
+        """The crossing table to read: ``post/crossings.csv``, or the gzipped copy a shipped
+        results folder holds when the table is large (``post/crossings.csv.gz``)."""
+        packed = self.post / "crossings.csv.gz"
+        return packed if not self.crossings_csv.is_file() and packed.is_file() else self.crossings_csv
+
+    @property
     def crossings_plot(self) -> Path:
         return self.post / "crossings.png"
 

@@ -9,7 +9,8 @@ Copies from a ``drumflow run`` directory (finished, or interrupted and post-proc
 
 * ``manifest.json``, ``case.toml``, ``summary.json``;
 * ``post/mean_temperature.csv``, ``post/air_heat.csv``, ``post/crossings.csv`` (above
-  ``--crossings-limit-mb`` a per-time-bin summary ``post/crossings_summary.csv`` instead), the
+  ``--crossings-limit-mb`` gzipped, ``post/crossings.csv.gz``, with a per-time-bin summary
+  ``post/crossings_summary.csv``), ``dem/coupling/rank*.csv`` (wall time per coupling update), the
   run's PNG plots (``post/*.png``, ``geometry/cross_section.png``, ``air/air_cross_section.png``);
 * ``post/methodology.json`` and ``post/steps.csv`` (the paper's particle conductivity in Nu),
   when the run is long enough for the methodology; else the reason goes into the record;
@@ -123,10 +124,29 @@ def ship(run_dir: Path, dest: Path, *, render_3d: bool = True, crossings_limit_m
         if size_mb <= crossings_limit_mb:
             shutil.copy2(crossings, dest / "post" / "crossings.csv")
         else:
-            table = crossings_summary(pd.read_csv(crossings), case.drum.length)
-            table.to_csv(dest / "post" / CROSSINGS_SUMMARY, index=False)
-            notes.append(f"post/crossings.csv is {size_mb:.1f} MB: shipped {CROSSINGS_SUMMARY} "
-                         f"(crossings per {CROSSING_BIN_S:g} s and axial fifth) instead")
+            table = pd.read_csv(crossings)
+            crossings_summary(table, case.drum.length).to_csv(dest / "post" / CROSSINGS_SUMMARY,
+                                                              index=False)
+            # Every crossing still, compressed: the time-to-answer replay counts them per
+            # coupling update (drumflow.rundir.RunDir.crossings_table reads it).
+            table.to_csv(dest / "post" / "crossings.csv.gz", index=False, float_format="%.6g",
+                         compression={"method": "gzip", "mtime": 0})
+            (dest / "post" / "crossings.csv").unlink(missing_ok=True)
+            notes.append(f"post/crossings.csv is {size_mb:.1f} MB: shipped gzipped "
+                         f"(post/crossings.csv.gz) with {CROSSINGS_SUMMARY} (crossings per "
+                         f"{CROSSING_BIN_S:g} s and axial fifth)")
+
+    # The coupling loop's per-update log (heat, drag, Python and LIGGGHTS wall seconds per
+    # rank): the measured wall times of `drumflow answer`, a few hundred kB.
+    logs = sorted(run.dem_coupling_logs.glob("rank*.csv")) if run.dem_coupling_logs.is_dir() else []
+    if logs:
+        target = dest / "dem" / "coupling"
+        if target.is_dir():
+            for old_log in target.glob("rank*.csv"):
+                old_log.unlink()
+        target.mkdir(parents=True, exist_ok=True)
+        for log in logs:
+            shutil.copy2(log, target / log.name)
 
     methodology_shipped = False
     try:

@@ -323,7 +323,7 @@ def replay_answer(
     run_dir
         A run directory after ``drumflow post``, or a shipped results folder of the same layout:
         ``case.toml``, ``post/mean_temperature.csv``, ``post/air_heat.csv``,
-        ``post/crossings.csv``; optionally ``dem/coupling/rank*.csv`` (wall times) and
+        ``post/crossings.csv`` (or ``.csv.gz``); optionally ``dem/coupling/rank*.csv`` (wall times) and
         ``run_record.json`` (wall time of a shipped run).
     tolerance
         The stop rule's largest relative half-width (``run.stop_tolerance``).
@@ -371,7 +371,7 @@ def replay_answer(
                        (run.mean_temperature_csv, "mean particle temperature and falling mass "
                         "per output step"),
                        (run.air_heat_csv, "the coupling log: heat the air took per update"),
-                       (run.crossings_csv, "the particles crossing the axis plane")):
+                       (run.crossings_table, "the particles crossing the axis plane")):
         if not path.is_file():
             raise MissingRunFileError(path, what)
     # The whole run first: it validates the files and is the reference.
@@ -387,9 +387,9 @@ def replay_answer(
     grid = _grid(out_t, start, check_interval_s, times)
 
     updates, dt = _updates(case, run, temps, end)
-    crossings = pd.read_csv(run.crossings_csv)
+    crossings = pd.read_csv(run.crossings_table)
     if "time" not in crossings.columns:
-        raise RunDirectoryError(f"{run.crossings_csv}: no column 'time' (rerun `drumflow post DIR`)")
+        raise RunDirectoryError(f"{run.crossings_table}: no column 'time' (rerun `drumflow post DIR`)")
     monitor = _monitor(case, run, updates, crossings, dt)
     wall, wall_info = _wall_per_update(run, updates, dt, particle_steps_per_s)
     notes: list[str] = []

@@ -110,7 +110,10 @@ def test_eq39_h_is_the_coupling_h_over_every_particle(paper_run: dict[str, Any])
 
 def test_shipped_results_are_small_and_redraw_the_same_numbers(paper_run: dict[str, Any]) -> None:
     shipped = paper_run["shipped"] / "model_two"
-    assert not (shipped / "dem").exists()  # never the dumps
+    # Never the dumps or restarts: of the DEM only the coupling loop's per-update log (wall
+    # times for `drumflow answer`).
+    dem_files = sorted(str(p.relative_to(shipped)) for p in (shipped / "dem").rglob("*") if p.is_file())
+    assert dem_files and all(f.startswith("dem/coupling/rank") and f.endswith(".csv") for f in dem_files)
     record = json.loads((shipped / "run_record.json").read_text())
     assert record["shipped"] is True and record["methodology_shipped"] is True
     assert sum(record["files"].values()) < 5e6
@@ -136,6 +139,7 @@ def test_shipped_results_are_small_and_redraw_the_same_numbers(paper_run: dict[s
 
 
 def test_large_crossings_are_shipped_as_a_summary(paper_run: dict[str, Any]) -> None:
+    import numpy as np
     import pandas as pd
 
     shipped = paper_run["root"] / "summarised" / "model_two"
@@ -147,6 +151,14 @@ def test_large_crossings_are_shipped_as_a_summary(paper_run: dict[str, Any]) -> 
     assert int(summary.filter(like="z_").to_numpy().sum()) == len(crossings)
     record = json.loads((shipped / "run_record.json").read_text())
     assert any("crossings_summary.csv" in n for n in record["notes"])
+    # ...and every crossing, gzipped, which the replay reads in place of the CSV.
+    from drumflow.rundir import RunDir
+
+    table = RunDir.existing(shipped).crossings_table
+    assert table.name == "crossings.csv.gz"
+    packed = pd.read_csv(table)
+    assert len(packed) == len(crossings)
+    assert np.allclose(packed["time"], crossings["time"], rtol=1e-5)
 
 
 def test_report_redraws_from_shipped_results(paper_run: dict[str, Any]) -> None:
