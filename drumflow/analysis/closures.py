@@ -233,7 +233,7 @@ def extract_closures(run_dir: Path | str, start_s: float | None = None) -> Slice
     ----------
     run_dir
         A ``drumflow run`` directory with ``case.toml``, ``post/crossings.csv`` and the
-        snapshots ``dem/dumps/snap.*.txt``.
+        snapshots ``dem/dumps/snap.*.txt or .npz``.
     start_s
         Ignore data before this time; default ``run.mass_flow_start``.
 

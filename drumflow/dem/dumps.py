@@ -1,12 +1,20 @@
-"""Reading LIGGGHTS text dumps (``dump custom``), fast, into numpy arrays.
+"""Reading LIGGGHTS text dumps (``dump custom``), fast, into numpy arrays; packing snapshots.
 
 meshio cannot read these files (and calls ``sys.exit`` on some failures), so drumflow reads
 them itself: a dump is nine header lines and a whitespace table, which pandas' C parser reads
 at tens of MB/s.
+
+A full snapshot of paper model one is 40 MB of text (467,443 particles) and takes half a second
+to parse; 36 of them made ``drumflow post`` slow and the run large. :func:`pack_dumps` turns
+each finished snapshot into ``snap.STEP.npz`` (id as int32, positions, velocities and radius as
+float32, which keep 7.2 significant digits against the text's 8, i.e. 0.1 um at 1.5 m;
+temperature as float64, every digit of the text): about half the size, read in milliseconds.
+:func:`read_dump` and :func:`dump_files` take either form, the packed one first.
 """
 
 from __future__ import annotations
 
+import os
 import re
 from dataclasses import dataclass
 from pathlib import Path
@@ -40,14 +48,23 @@ def _canonical(name: str) -> str:
     return "T" if name.startswith("f_Temp") else name
 
 
+#: Suffix of a packed snapshot.
+PACKED = ".npz"
+#: Columns packed as float32 (the rest as float64, ``id`` as int32).
+_SINGLE = frozenset({"x", "y", "z", "vx", "vy", "vz", "radius", "fx", "fy", "fz",
+                     "omegax", "omegay", "omegaz"})
+
+
 def read_dump(path: Path) -> Snapshot:
-    """Read one LIGGGHTS ``dump custom`` text file.
+    """Read one LIGGGHTS ``dump custom`` text file, or its packed form (``.npz``).
 
     Raises
     ------
     RunDirectoryError
         When the file is not a LIGGGHTS custom dump (names the file and what is wrong).
     """
+    if path.suffix == PACKED:
+        return _read_packed(path)
     with path.open("r") as fh:
         header = [fh.readline() for _ in range(9)]
     if not header[0].startswith("ITEM: TIMESTEP") or not header[8].startswith("ITEM: ATOMS"):
@@ -78,15 +95,64 @@ def read_dump(path: Path) -> Snapshot:
     return Snapshot(step, {n: np.ascontiguousarray(table[:, i]) for i, n in enumerate(names)})
 
 
+def _read_packed(path: Path) -> Snapshot:
+    try:
+        with np.load(path, allow_pickle=False) as data:
+            names = [str(n) for n in data["names"]]
+            step = int(data["step"])
+            columns = {n: np.ascontiguousarray(data[f"c_{n}"], dtype=np.float64) for n in names}
+    except (OSError, KeyError, ValueError) as exc:
+        raise RunDirectoryError(f"{path}: not a packed drumflow snapshot ({exc})") from None
+    return Snapshot(step, columns)
+
+
+def _step_of(p: Path) -> int:
+    m = _STEP_RE.findall(p.name)
+    return int(m[-1]) if m else -1
+
+
 def dump_files(folder: Path, prefix: str = "snap") -> list[Path]:
-    """The dump files ``PREFIX.<step>.txt`` of a folder in time order."""
-    files = [p for p in folder.glob(f"{prefix}.*.txt") if p.is_file()]
+    """The dump files ``PREFIX.<step>.txt`` (or packed, ``.npz``) of a folder in time order;
+    of a step found in both forms, the packed one."""
+    by_step: dict[int, Path] = {}
+    for p in folder.glob(f"{prefix}.*.txt"):
+        if p.is_file():
+            by_step.setdefault(_step_of(p), p)
+    for p in folder.glob(f"{prefix}.*{PACKED}"):
+        if p.is_file():
+            by_step[_step_of(p)] = p  # written whole, then renamed: complete when present
+    return [by_step[k] for k in sorted(by_step)]
 
-    def step_of(p: Path) -> int:
-        m = _STEP_RE.findall(p.name)
-        return int(m[-1]) if m else -1
 
-    return sorted(files, key=step_of)
+def pack_dump(path: Path) -> Path:
+    """Pack one text dump into ``.npz`` beside it and remove the text; return the new path.
+
+    The packed file is written under a temporary name and renamed, so that a reader (or a
+    run stopped half way) never sees a partial one; the text goes only after the rename.
+    """
+    snap = read_dump(path)
+    target = path.with_suffix(PACKED)
+    arrays: dict[str, NDArray[np.generic]] = {
+        "step": np.array(snap.step, dtype=np.int64),
+        "names": np.array(list(snap.columns), dtype=np.str_),
+    }
+    for name, values in snap.columns.items():
+        dtype = np.int32 if name == "id" else np.float32 if name in _SINGLE else np.float64
+        arrays[f"c_{name}"] = values.astype(dtype)
+    partial = target.with_name(target.name + ".partial")
+    with partial.open("wb") as fh:
+        np.savez(fh, **arrays)  # type: ignore[arg-type]
+    os.replace(partial, target)
+    path.unlink()
+    return target
+
+
+def pack_dumps(folder: Path, prefix: str = "snap", keep_newest: int = 0) -> list[Path]:
+    """Pack every text dump ``PREFIX.*.txt`` of ``folder`` but the ``keep_newest`` newest (while
+    LIGGGHTS runs, the newest may still be being written). Returns the packed files."""
+    texts = sorted((p for p in folder.glob(f"{prefix}.*.txt") if p.is_file()), key=_step_of)
+    done = texts[: max(0, len(texts) - keep_newest)]
+    return [pack_dump(p) for p in done]
 
 
 @dataclass(frozen=True)
@@ -121,7 +187,7 @@ def read_series(
     """
     files = dump_files(folder, prefix)
     if not files:
-        raise RunDirectoryError(f"{folder}: no dump files ({prefix}.*.txt)")
+        raise RunDirectoryError(f"{folder}: no dump files ({prefix}.*.txt or .npz)")
     snaps = [read_dump(f) for f in files]
     for f, s in zip(files, snaps, strict=True):
         missing = [c for c in columns if c not in s.columns]

@@ -31,6 +31,7 @@ from drumflow.dem.deck import (
     render_deck,
     short_plan,
 )
+from drumflow.dem.dumps import pack_dumps
 from drumflow.dem.placement import place_particles, write_data_file
 from drumflow.dem.stability import (
     LOST_PREFIX,
@@ -184,11 +185,13 @@ KEEP_RESTARTS = 2
 PRUNE_EVERY_S = 60.0
 
 
-def prune_restarts(folder: Path, keep: int = KEEP_RESTARTS) -> list[Path]:
+def prune_restarts(folder: Path, keep: int = KEEP_RESTARTS, protect: Path | None = None) -> list[Path]:
     """Remove all but the ``keep`` newest ``drum.STEP.restart`` files of ``folder``.
 
     Safe while LIGGGHTS runs: a file it is still writing is the newest, and the newest are
-    kept. Other files (``final.restart``) are not touched. Returns the removed paths.
+    kept. Other files (``final.restart``) and ``protect`` (the restart this attempt resumed
+    from, which its deck names and the resume check reads) are not touched. Returns the removed
+    paths.
     """
     steps: list[tuple[int, Path]] = []
     for p in folder.glob("drum.*.restart"):
@@ -196,7 +199,8 @@ def prune_restarts(folder: Path, keep: int = KEEP_RESTARTS) -> list[Path]:
         if m:
             steps.append((int(m.group(1)), p))
     steps.sort()
-    removed = [p for _, p in steps[:max(0, len(steps) - keep)]]
+    removed = [p for _, p in steps[:max(0, len(steps) - keep)]
+               if protect is None or p.resolve() != protect.resolve()]
     for p in removed:
         p.unlink(missing_ok=True)
     return removed
@@ -216,7 +220,8 @@ def _prepare_workdir(case: Case, rundir: RunDir, inputs: DemInputs, key: str) ->
     if inputs.steps is None and rundir.manifest.get("dem_key") == key:
         resume = _latest_restart(rundir.dem_restart)
     if resume is None:
-        stale = [*rundir.dem_dumps.glob("*.txt"), *rundir.dem_restart.glob("*.restart"),
+        stale = [*rundir.dem_dumps.glob("*.txt"), *rundir.dem_dumps.glob("*.npz*"),
+                 *rundir.dem_restart.glob("*.restart"),
                  *rundir.dem.glob("log.resume-*.liggghts"), *rundir.dem_coupling_logs.glob("*.csv"),
                  *rundir.dem_coupling_logs.glob("*.json")]
         for old in stale:
@@ -269,7 +274,8 @@ class _RowWatcher:
     """Every thermo row goes to the progress bar and to the stability monitor, which stops the
     run at the first row that breaks a physical bound."""
 
-    def __init__(self, case: Case, inputs: DemInputs, own_log: Path, restarts: Path) -> None:
+    def __init__(self, case: Case, inputs: DemInputs, own_log: Path, restarts: Path,
+                 dumps: Path, resumed_from: Path | None) -> None:
         total = inputs.plan.steps * inputs.plan.time_step
         progress = inputs.progress
         self.parser = ThermoParser(
@@ -281,6 +287,8 @@ class _RowWatcher:
         self.own_log = own_log
         self.command: list[str] = []
         self.restarts = restarts
+        self.dumps = dumps
+        self.resumed_from = resumed_from
         self._pruned_at = time.monotonic()
 
     def __call__(self, line: str) -> None:
@@ -289,7 +297,9 @@ class _RowWatcher:
         if len(self.parser.rows) == before:
             return
         if time.monotonic() - self._pruned_at > PRUNE_EVERY_S:
-            prune_restarts(self.restarts)
+            prune_restarts(self.restarts, protect=self.resumed_from)
+            # Every finished snapshot packed (the newest may still be being written).
+            pack_dumps(self.dumps, "snap", keep_newest=1)
             self._pruned_at = time.monotonic()
         row = self.parser.rows[-1]
         diagnosis = self.monitor.check(int(row[0]), row[1], int(row[2]), row[3], row[4], row[6])
@@ -304,9 +314,11 @@ class _RowWatcher:
 
 
 def _launch(case: Case, rundir: RunDir, runner: Runner, inputs: DemInputs, deck_name: str,
-            context: dict[str, Any], suffix: str) -> tuple[_RowWatcher, Path, float]:
+            context: dict[str, Any], suffix: str,
+            resumed_from: Path | None) -> tuple[_RowWatcher, Path, float]:
     """Run LIGGGHTS (or the coupling loop) with the stability monitor; return the watcher, the
-    standard-output log and the wall time."""
+    standard-output log and the wall time. Restarts are pruned and snapshots packed as it goes;
+    ``resumed_from``, the restart this attempt started from, is kept."""
     work = rundir.dem
     # LIGGGHTS writes (and flushes) its own log, which feeds the progress bar; the runner
     # keeps standard output separately.
@@ -322,7 +334,7 @@ def _launch(case: Case, rundir: RunDir, runner: Runner, inputs: DemInputs, deck_
                                                       end_commands(context))
         _add_loop_options(spec_path, case, inputs.plan)
         command = driver_command(runner.profile, inputs.processes, COUPLING_FILE)
-    watcher = _RowWatcher(case, inputs, own_log, rundir.dem_restart)
+    watcher = _RowWatcher(case, inputs, own_log, rundir.dem_restart, rundir.dem_dumps, resumed_from)
     watcher.command = command
     t0 = time.perf_counter()
     try:
@@ -344,7 +356,8 @@ def _launch(case: Case, rundir: RunDir, runner: Runner, inputs: DemInputs, deck_
     finally:
         rundir.record_commands([r.as_dict() for r in runner.records if r.program == "liggghts"][-1:])
     wall = time.perf_counter() - t0
-    prune_restarts(rundir.dem_restart)
+    prune_restarts(rundir.dem_restart, protect=resumed_from)
+    pack_dumps(rundir.dem_dumps, "snap")
     rundir.record("stability", watcher.record(stopped=False))
     return watcher, log, wall
 
@@ -370,7 +383,8 @@ def run(case: Case, rundir: RunDir, runner: Runner, inputs: DemInputs) -> DemRes
     resume = _prepare_workdir(case, rundir, inputs, key)
     deck_name, context = _write_deck(case, rundir, inputs, resume)
     suffix = "" if resume is None else f".resume-{resume[1]}"
-    watcher, log, wall = _launch(case, rundir, runner, inputs, deck_name, context, suffix)
+    watcher, log, wall = _launch(case, rundir, runner, inputs, deck_name, context, suffix,
+                                 None if resume is None else resume[0])
     rows = watcher.parser.rows
     n = case.particle_count
     first_atoms = int(rows[0][2]) if rows else 0

@@ -1,6 +1,6 @@
 """Figure 6 in motion: the drum's cross-section, coloured by temperature, snapshot by snapshot.
 
-:func:`render_animation` draws every full snapshot of a run (``dem/dumps/snap.*.txt``) the way
+:func:`render_animation` draws every full snapshot of a run (``dem/dumps/snap.*.txt or .npz``) the way
 :func:`drumflow.report.paper.render_snapshot_panels` draws four of them: the particles projected
 on the section (x-y, seen along the drum axis), one colour scale for the whole run so that the
 cooling shows from frame to frame, the shell, and the lifters turned to the drum angle of the
@@ -102,7 +102,7 @@ def render_animation(run: RunDir, case: Case, target: Path | None = None, *,
     Parameters
     ----------
     run
-        The run directory (needs ``dem/dumps/snap.*.txt``).
+        The run directory (needs ``dem/dumps/snap.*.txt or .npz``).
     case
         The run's case (drum radius and speed, lifters, particle size).
     target
@@ -140,7 +140,7 @@ def render_animation(run: RunDir, case: Case, target: Path | None = None, *,
         raise ValueError(f"max_frames = {max_frames}: must be at least 1")
     files = dump_files(run.dem_dumps, "snap")
     if not files:
-        raise RunDirectoryError(f"{run.dem_dumps}: no particle snapshot (snap.*.txt)")
+        raise RunDirectoryError(f"{run.dem_dumps}: no particle snapshot (snap.*.txt or .npz)")
     dt = _time_step(run) or case.run.dump_interval
     snaps = []
     skipped: list[str] = []

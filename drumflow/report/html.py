@@ -264,7 +264,7 @@ def _particles_figure(run: RunDir, case: Case, manifest: dict[str, Any] | None,
 
     files = dump_files(run.dem_dumps, "snap")
     if not files:
-        fig.note = f"no particle snapshot in {run.dem_dumps} (snap.*.txt)"
+        fig.note = f"no particle snapshot in {run.dem_dumps} (snap.*.txt or .npz)"
         return fig
     try:
         snap = read_dump(files[-1])

@@ -147,7 +147,7 @@ def _dump_span_s(run: RunDir) -> tuple[float, float] | None:
     """(first, last) modification time of the dump files: when the DEM wrote its output."""
     if not run.dem_dumps.is_dir():
         return None
-    times = [p.stat().st_mtime for p in run.dem_dumps.glob("*.txt")]
+    times = [p.stat().st_mtime for p in (*run.dem_dumps.glob("*.txt"), *run.dem_dumps.glob("*.npz"))]
     return (min(times), max(times)) if times else None
 
 
@@ -256,7 +256,7 @@ def air_side_of_run(root: Path | str) -> dict[str, Any]:
         field = AirField.from_npz(run.air_field)
         sample = sample_air_side(case, field, snap.columns, snap.step * dt)
         return {**sample.to_dict(), "snapshot": path.name, "field_cells": field.meta.get("cells")}
-    raise RunDirectoryError(f"{run.dem_dumps}: no readable particle snapshot (snap.*.txt)")
+    raise RunDirectoryError(f"{run.dem_dumps}: no readable particle snapshot (snap.*.txt or .npz)")
 
 
 def render_last_snapshot(run: RunDir, case: Case, target: Path, timeout_s: float) -> Path:
@@ -277,7 +277,7 @@ def render_last_snapshot(run: RunDir, case: Case, target: Path, timeout_s: float
             c["x"], c["y"], c["z"], c["T"], target, case.drum.radius, case.drum.length,
             particle_diameter=case.particles.diameter, title=f"{case.name}, {when}",
             timeout_s=timeout_s)
-    raise RunDirectoryError(f"{run.dem_dumps}: no readable particle snapshot (snap.*.txt)")
+    raise RunDirectoryError(f"{run.dem_dumps}: no readable particle snapshot (snap.*.txt or .npz)")
 
 
 def render_snapshot_panels(run: RunDir, case: Case, target: Path, panels: int = 4) -> Path:
@@ -301,7 +301,7 @@ def render_snapshot_panels(run: RunDir, case: Case, target: Path, panels: int = 
 
     files = dump_files(run.dem_dumps, "snap")
     if not files:
-        raise RunDirectoryError(f"{run.dem_dumps}: no particle snapshot (snap.*.txt)")
+        raise RunDirectoryError(f"{run.dem_dumps}: no particle snapshot (snap.*.txt or .npz)")
     picks = sorted({round(i) for i in np.linspace(0, len(files) - 1, min(panels, len(files)))})
     snaps = []
     for i in picks:
@@ -512,7 +512,8 @@ def needs_post(root: Path | str) -> bool:
     if is_shipped(path):
         return False
     run = RunDir.existing(path)
-    dumps = list(run.dem_dumps.glob("*.txt")) if run.dem_dumps.is_dir() else []
+    dumps = ([*run.dem_dumps.glob("*.txt"), *run.dem_dumps.glob("*.npz")]
+             if run.dem_dumps.is_dir() else [])
     if not dumps or not run.dem_log.is_file():
         return False
     newest = max(p.stat().st_mtime for p in dumps)

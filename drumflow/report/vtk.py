@@ -2,7 +2,7 @@
 
 Written into ``OUT`` (default ``RUN_DIR/vtk``):
 
-* ``particles.pvd``: one binary ``.vtu`` per full snapshot (``dem/dumps/snap.*.txt``), every
+* ``particles.pvd``: one binary ``.vtu`` per full snapshot (``dem/dumps/snap.*.txt or .npz``), every
   particle a vertex with point data ``id``, ``velocity`` (m/s), ``radius`` (m) and
   ``temperature`` (deg C); the ``.pvd`` collection gives ParaView the simulated times;
 * ``walls.pvd``: the walls as LIGGGHTS saw them at each snapshot: part 0 the rotating part of
@@ -170,7 +170,7 @@ def export_vtk(run_dir: Path | str, out: Path | str | None = None) -> VtkExport:
         raise RunDirectoryError(f"{rundir.root}/manifest.json: no DEM time step recorded; rerun the case")
     files = dump_files(rundir.dem_dumps, "snap")
     if not files:
-        raise RunDirectoryError(f"{rundir.dem_dumps}: no snapshots (snap.*.txt)")
+        raise RunDirectoryError(f"{rundir.dem_dumps}: no snapshots (snap.*.txt or .npz)")
     target = Path(out) if out is not None else rundir.root / "vtk"
     (target / "particles").mkdir(parents=True, exist_ok=True)
     (target / "walls").mkdir(parents=True, exist_ok=True)

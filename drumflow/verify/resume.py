@@ -104,7 +104,8 @@ def lifter_angle_at_resume(run_dir: Path, work: Path, runner: Runner | None = No
     if work.exists():
         shutil.rmtree(work)
     shutil.copytree(run_dir / "geometry", work / "geometry")
-    shutil.copytree(run_dir / "dem", work / "dem", ignore=shutil.ignore_patterns("*.txt", "*.csv", "log*"))
+    shutil.copytree(run_dir / "dem", work / "dem",
+                    ignore=shutil.ignore_patterns("*.txt", "*.npz", "*.csv", "log*"))
     # The resume deck with air ends at its set-up (`run 0`): the loop runs the steps. Dump the
     # lifter mesh as LIGGGHTS holds it there (a dump writes at the set-up of a run).
     if not re.fullmatch(r"run\s+0", deck.rstrip().splitlines()[-1].strip()):

@@ -121,3 +121,52 @@ def test_crossings_from_band_dumps(tmp_path: Path) -> None:
     # Particle 1: y 0.03 -> -0.01 over 0.01 s crosses at 3/4 of the interval.
     assert table["time"].tolist() == pytest.approx([0.0075, 0.0125])
     assert table["z"].iloc[1] == pytest.approx(0.05 + 0.25 * 0.02)
+
+
+# ----------------------------------------------------------------------- packed snapshots
+
+
+def test_packed_snapshot_reads_back_what_the_text_held(tmp_path: Path) -> None:
+    from drumflow.dem.dumps import dump_files, pack_dumps
+
+    rng = np.random.default_rng(3)
+    n = 500
+    rows = [(int(i), *np.round(rng.uniform(-1.5, 1.5, 6), 7), 0.004, round(float(t), 6))
+            for i, t in zip(rng.permutation(n) + 1, rng.uniform(30.0, 90.0, n), strict=True)]
+    for step in (0, 50, 100):
+        _write(tmp_path, step, rows)
+    text = {p.name: read_dump(p) for p in dump_files(tmp_path)}
+    series_text = read_series(tmp_path, time_step=0.01)
+    # During a run the newest dump may be being written: it stays text.
+    packed = pack_dumps(tmp_path, keep_newest=1)
+    assert [p.name for p in packed] == ["snap.0000000000.npz", "snap.0000000050.npz"]
+    assert [p.name for p in dump_files(tmp_path)] == [
+        "snap.0000000000.npz", "snap.0000000050.npz", "snap.0000000100.txt"]
+    pack_dumps(tmp_path)
+    assert sorted(p.name for p in tmp_path.iterdir()) == [
+        "snap.0000000000.npz", "snap.0000000050.npz", "snap.0000000100.npz"]
+    for name, before in text.items():
+        after = read_dump(tmp_path / name.replace(".txt", ".npz"))
+        assert after.step == before.step and list(after.columns) == list(before.columns)
+        assert np.array_equal(after.ids, before.ids)
+        # Temperatures: every digit; positions, velocities, radius: float32, 6e-8 relative
+        # (the text's 8 digits are 1e-7 m at 1.5 m).
+        assert np.array_equal(after.columns["T"], before.columns["T"])
+        for c in ("x", "y", "z", "vx", "vy", "vz", "radius"):
+            np.testing.assert_allclose(after.columns[c], before.columns[c], rtol=6e-8, atol=0)
+    series = read_series(tmp_path, time_step=0.01)
+    assert np.array_equal(series.steps, series_text.steps)
+    assert np.array_equal(series["T"], series_text["T"])
+
+
+def test_a_partial_pack_is_ignored_and_a_bad_one_named(tmp_path: Path) -> None:
+    from drumflow.dem.dumps import dump_files
+
+    _write(tmp_path, 10, [(1, 0, 0.1, 0, 0, 0, 0, 0.004, 90)])
+    # A run stopped while packing leaves the temporary file: the text is still the dump.
+    (tmp_path / "snap.0000000010.npz.partial").write_bytes(b"half")
+    assert [p.name for p in dump_files(tmp_path)] == ["snap.0000000010.txt"]
+    bad = tmp_path / "snap.0000000020.npz"
+    bad.write_bytes(b"not a zip")
+    with pytest.raises(RunDirectoryError, match="not a packed drumflow snapshot"):
+        read_dump(bad)
