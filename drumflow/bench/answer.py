@@ -601,7 +601,7 @@ def _row(t: float, case: Case, run: RunDir, result: MethodologyResult | None,
                             if in_h.any() else math.nan),
         )
     upto = crossings[crossings["time"] <= t + _TIME_EPS_S]
-    eq57 = falling_mass_flow(upto, case.dem_case().particles.mass, start=start)
+    eq57 = falling_mass_flow(upto, float(monitor.rule["particle_mass_kg"]), start=start)
     row["eq57_mass_flow_kg_s"] = eq57.mass_flow_kg_s if eq57.crossings >= 2 else math.nan
     row.update(_steady_mass_flow(temps, start, t))
 
