@@ -366,14 +366,21 @@ def test_model_two_at_its_end_is_the_methodology(model_two: AnswerReplay) -> Non
 
 
 def test_model_two_rule_and_wall_invariants(model_two: AnswerReplay, tmp_path: Path) -> None:
-    # 12 lifters at 5 rpm: one passing a second, so 'auto' is 1 s + 3 s; the run ends at 3.52 s.
+    # 12 lifters at 5 rpm: one passing a second, so 'auto' is 1 s + 3 s.
     assert model_two.min_stop_time_s == pytest.approx(4.0)
-    assert model_two.first_fire_s is None and not model_two.table["converged"].any()
-    assert model_two.table["time_s"].is_monotonic_increasing
-    record = json.loads((MODEL_TWO / "run_record.json").read_text())
-    assert model_two.wall["source"] == "rate"
-    assert model_two.table["wall_s"].iloc[-1] == pytest.approx(record["dem_wall_time_s"], rel=1e-9)
-    assert model_two.table["wall_s"].is_monotonic_increasing
+    table = model_two.table
+    assert table["time_s"].is_monotonic_increasing
+    # The rule fires once and stays satisfied only if the grid says so from then on.
+    if model_two.first_fire_s is None:
+        assert not table["converged"].any()
+    else:
+        assert not table.loc[table["time_s"] < model_two.first_fire_s - 1e-9, "converged"].any()
+    # The shipped run carries the coupling loop's per-update log from 3.47 s (the code that logs
+    # wall times); the attempts before it are estimated at the rate of the logged updates.
+    assert model_two.wall["source"] == "measured+rate"
+    assert model_two.wall["measured_updates"] > 0 and model_two.wall["estimated_updates"] > 0
+    assert table["wall_s"].is_monotonic_increasing
+    assert table["wall_estimated_share"].iloc[-1] < 1.0
     # The whole-surface h of the monitor and the paper's h agree to a few percent (the paper
     # divides by the falling particles' area instead, and the falling mass cancels).
     last = model_two.reference
