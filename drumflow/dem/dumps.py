@@ -147,12 +147,26 @@ def pack_dump(path: Path) -> Path:
     return target
 
 
-def pack_dumps(folder: Path, prefix: str = "snap", keep_newest: int = 0) -> list[Path]:
+def pack_dumps(folder: Path, prefix: str = "snap", keep_newest: int = 0,
+               skip_unreadable: bool = False) -> list[Path]:
     """Pack every text dump ``PREFIX.*.txt`` of ``folder`` but the ``keep_newest`` newest (while
-    LIGGGHTS runs, the newest may still be being written). Returns the packed files."""
+    LIGGGHTS runs, the newest may still be being written). Returns the packed files.
+
+    Raises
+    ------
+    RunDirectoryError
+        A dump is not readable (cut short, say), unless ``skip_unreadable``: it then stays text
+        and the others are packed.
+    """
     texts = sorted((p for p in folder.glob(f"{prefix}.*.txt") if p.is_file()), key=_step_of)
-    done = texts[: max(0, len(texts) - keep_newest)]
-    return [pack_dump(p) for p in done]
+    packed = []
+    for path in texts[: max(0, len(texts) - keep_newest)]:
+        try:
+            packed.append(pack_dump(path))
+        except RunDirectoryError:
+            if not skip_unreadable:
+                raise
+    return packed
 
 
 @dataclass(frozen=True)

@@ -206,6 +206,19 @@ def prune_restarts(folder: Path, keep: int = KEEP_RESTARTS, protect: Path | None
     return removed
 
 
+def _tidy_output(restarts: Path, dumps: Path, resumed_from: Path | None,
+                 keep_newest_snapshot: bool) -> None:
+    """Prune restarts and pack finished snapshots. Housekeeping never stops a run: a file that
+    cannot be packed (a snapshot cut short by an earlier kill) stays text, for ``drumflow post``
+    to name."""
+    try:
+        prune_restarts(restarts, protect=resumed_from)
+        pack_dumps(dumps, "snap", keep_newest=1 if keep_newest_snapshot else 0,
+                   skip_unreadable=True)
+    except OSError:
+        pass  # a full disk or a vanished folder: the run itself will say so if it matters
+
+
 def _stability_record(limits: StabilityLimits, monitor: StabilityMonitor, stopped: bool) -> dict[str, Any]:
     return {"limits": limits.as_dict(), "stopped": stopped, "warnings": list(monitor.warnings),
             "max_overlap_m": monitor.max_overlap, "max_kinetic_energy_J": monitor.max_kinetic_energy}
@@ -297,9 +310,7 @@ class _RowWatcher:
         if len(self.parser.rows) == before:
             return
         if time.monotonic() - self._pruned_at > PRUNE_EVERY_S:
-            prune_restarts(self.restarts, protect=self.resumed_from)
-            # Every finished snapshot packed (the newest may still be being written).
-            pack_dumps(self.dumps, "snap", keep_newest=1)
+            _tidy_output(self.restarts, self.dumps, self.resumed_from, keep_newest_snapshot=True)
             self._pruned_at = time.monotonic()
         row = self.parser.rows[-1]
         diagnosis = self.monitor.check(int(row[0]), row[1], int(row[2]), row[3], row[4], row[6])
@@ -356,8 +367,7 @@ def _launch(case: Case, rundir: RunDir, runner: Runner, inputs: DemInputs, deck_
     finally:
         rundir.record_commands([r.as_dict() for r in runner.records if r.program == "liggghts"][-1:])
     wall = time.perf_counter() - t0
-    prune_restarts(rundir.dem_restart, protect=resumed_from)
-    pack_dumps(rundir.dem_dumps, "snap")
+    _tidy_output(rundir.dem_restart, rundir.dem_dumps, resumed_from, keep_newest_snapshot=False)
     rundir.record("stability", watcher.record(stopped=False))
     return watcher, log, wall
 

@@ -170,3 +170,17 @@ def test_a_partial_pack_is_ignored_and_a_bad_one_named(tmp_path: Path) -> None:
     bad.write_bytes(b"not a zip")
     with pytest.raises(RunDirectoryError, match="not a packed drumflow snapshot"):
         read_dump(bad)
+
+
+def test_a_dump_cut_short_stays_text_and_the_others_are_packed(tmp_path: Path) -> None:
+    from drumflow.dem.dumps import pack_dumps
+
+    _write(tmp_path, 10, [(1, 0, 0.1, 0, 0, 0, 0, 0.004, 90)])
+    (tmp_path / "snap.0000000020.txt").write_text(DUMP.format(step=20, n=3, rows="1 0 0 0 0 0 0 0.004 90 \n"))
+    _write(tmp_path, 30, [(1, 0, 0.1, 0, 0, 0, 0, 0.004, 80)])
+    with pytest.raises(RunDirectoryError, match="header says 3 particles"):
+        pack_dumps(tmp_path)
+    # During a run, housekeeping skips it: the run goes on, and post names the file later.
+    packed = pack_dumps(tmp_path, skip_unreadable=True)
+    assert [p.name for p in packed] == ["snap.0000000030.npz"]
+    assert (tmp_path / "snap.0000000020.txt").exists()
