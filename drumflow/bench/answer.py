@@ -415,8 +415,10 @@ def replay_answer(
         fire_row = _row(first_fire, case, run, None, falling_mass, temps, crossings, updates,
                         monitor, wall, tolerance, min_time, [])
         at_fire = {key: fire_row[key] for key in
-                   ("time_s", "temperature_C", "mass_flow_kg_s", "h_W_m2K", "wall_s")}
-        for name, (col, _) in QUANTITIES.items():
+                   ("time_s", "temperature_C", "mass_flow_kg_s", "h_W_m2K", "wall_s",
+                    "steady_mass_flow_kg_s", "steady_start_s")}
+        for name, (col, _) in (*QUANTITIES.items(),
+                               ("steady_mass_flow", ("steady_mass_flow_kg_s", ""))):
             at_fire[f"rel_{name}"] = float(fire_row[col]) / float(ref[col]) - 1.0
     settled = {name: settled_time(table["time_s"], table[f"rel_{name}"], settle_tolerance)
                for name in (*QUANTITIES, "temperature_drop", "steady_mass_flow")}

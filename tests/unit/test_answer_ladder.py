@@ -102,6 +102,10 @@ def test_rungs_stop_where_their_rules_say_with_walls_and_errors(folder: Path) ->
     assert own.first_fire_s is not None
     assert rows.loc["rule", "stop_time_s"] == pytest.approx(own.first_fire_s)
     assert rows.loc["rule", "value_h"] == pytest.approx(own.at_first_fire["h_W_m2K"])
+    # Regression: the firing's record lacked the cascading bed's flow (NaN in the ladder).
+    assert rows.loc["rule", "value_steady_mass_flow"] == pytest.approx(
+        own.at_first_fire["steady_mass_flow_kg_s"])
+    assert np.isfinite(rows.loc["rule", "value_steady_mass_flow"])
     # 5 % more h: never within 1 % of the reference; errors shown at the end.
     assert np.isnan(rows.loc["biased", "stop_time_s"]) and not rows.loc["biased", "within_tolerance"]
     assert rows.loc["biased", "error_h"] == pytest.approx(0.05, abs=2e-3)
