@@ -184,8 +184,17 @@ def post_run(out: Path | str, case: Case | None = None) -> dict[str, Any]:
     # run.crossings = "loop": the coupling loop wrote the crossings themselves; else they come
     # from the band dump.
     table = read_loop_crossings(loop_crossings) if loop_crossings.exists() else None
-    rows = None if table is not None else read_rows(dumps, float(ts), prefix="cross")
-    snaps = read_series(dumps, float(ts), prefix="snap")
+    # A run still going (or killed mid-write) may leave its newest dump cut short: it is left
+    # out, and the series end at the last complete crossing dump (the crossings of the next
+    # interval need it).
+    rows = (None if table is not None
+            else read_rows(dumps, float(ts), prefix="cross", skip_partial_newest=True))
+    snaps = read_series(dumps, float(ts), prefix="snap", skip_partial_newest=True)
+    skipped = [*(rows.skipped if rows is not None else ()), *snaps.skipped]
+    if rows is not None and rows.skipped:
+        thermo = thermo[thermo["step"] <= int(rows.steps[-1])].reset_index(drop=True)
+        times = thermo["step"].to_numpy() * float(ts)
+        T_mean = thermo["T_mean"].to_numpy()
     read_s = time.perf_counter() - t0
     mass = case.particles.mass
     if table is not None:
@@ -238,6 +247,7 @@ def post_run(out: Path | str, case: Case | None = None) -> dict[str, Any]:
         "case_hash": user_case.hash(),
         **({"coarse_grain": user_case.particles.coarse_grain}
            if user_case.particles.coarse_grain != 1.0 else {}),
+        **({"dumps_skipped": [p.name for p in skipped]} if skipped else {}),
         "particles_initial": case.particle_count,
         "particles_final": final,
         "particles_escaped_through_walls": escaped,

@@ -178,9 +178,23 @@ class DumpSeries:
     ids: NDArray[np.int64]
     fields: dict[str, NDArray[np.float64]]  # each (n_times, n_particles)
     counts: NDArray[np.int64]  # particles present in each dump
+    skipped: tuple[Path, ...] = ()  # the newest file, left out because it is cut short
 
     def __getitem__(self, name: str) -> NDArray[np.float64]:
         return self.fields[name]
+
+
+def _read_files(files: list[Path], skip_partial_newest: bool) -> tuple[list[Snapshot], tuple[Path, ...]]:
+    """Read the dumps; with ``skip_partial_newest``, leave out the newest when it cannot be read
+    (LIGGGHTS is still writing it, or a kill cut it short)."""
+    snaps = [read_dump(f) for f in files[:-1]]
+    try:
+        snaps.append(read_dump(files[-1]))
+    except RunDirectoryError:
+        if not skip_partial_newest or len(files) < 2:
+            raise
+        return snaps, (files[-1],)
+    return snaps, ()
 
 
 def read_series(
@@ -188,21 +202,24 @@ def read_series(
     time_step: float,
     columns: tuple[str, ...] = ("x", "y", "z", "T"),
     prefix: str = "snap",
+    skip_partial_newest: bool = False,
 ) -> DumpSeries:
     """Read every dump of a folder into arrays over (time, particle).
 
     Particles missing from a dump (lost) get NaN there, so a loss never shifts rows; the
-    per-dump counts are kept for reporting.
+    per-dump counts are kept for reporting. ``skip_partial_newest``: a newest dump that cannot
+    be read (a run still writing it) is left out and named in :attr:`DumpSeries.skipped`.
 
     Raises
     ------
     RunDirectoryError
-        When the folder has no dumps or a dump lacks a requested column.
+        When the folder has no dumps, a dump lacks a requested column, or a dump cannot be read.
     """
     files = dump_files(folder, prefix)
     if not files:
         raise RunDirectoryError(f"{folder}: no dump files ({prefix}.*.txt or .npz)")
-    snaps = [read_dump(f) for f in files]
+    snaps, skipped = _read_files(files, skip_partial_newest)
+    files = files[: len(snaps)]
     for f, s in zip(files, snaps, strict=True):
         missing = [c for c in columns if c not in s.columns]
         if missing:
@@ -220,6 +237,7 @@ def read_series(
         ids=ids,
         fields=fields,
         counts=np.array([len(s) for s in snaps], dtype=np.int64),
+        skipped=skipped,
     )
 
 
@@ -237,26 +255,29 @@ class DumpRows:
     frame: NDArray[np.int64]
     ids: NDArray[np.int64]
     fields: dict[str, NDArray[np.float64]]
+    skipped: tuple[Path, ...] = ()  # the newest file, left out because it is cut short
 
     def __getitem__(self, name: str) -> NDArray[np.float64]:
         return self.fields[name]
 
 
-def read_rows(folder: Path, time_step: float, prefix: str = "cross") -> DumpRows:
-    """Read every ``PREFIX.*.txt`` dump of a folder into a :class:`DumpRows` table.
+def read_rows(folder: Path, time_step: float, prefix: str = "cross",
+              skip_partial_newest: bool = False) -> DumpRows:
+    """Read every ``PREFIX.*.txt`` dump of a folder into a :class:`DumpRows` table
+    (``skip_partial_newest`` as in :func:`read_series`).
 
     Raises
     ------
     RunDirectoryError
-        When the folder has no such dumps.
+        When the folder has no such dumps, or one cannot be read.
     """
     files = dump_files(folder, prefix)
     if not files:
         raise RunDirectoryError(f"{folder}: no dump files ({prefix}.*.txt)")
-    snaps = [read_dump(f) for f in files]
+    snaps, skipped = _read_files(files, skip_partial_newest)
     names = [n for n in snaps[0].columns if n != "id"]
     frame = np.concatenate([np.full(len(s), i, dtype=np.int64) for i, s in enumerate(snaps)])
     ids = np.concatenate([s.ids for s in snaps])
     fields = {n: np.concatenate([s.columns[n] for s in snaps]) for n in names}
     steps = np.array([s.step for s in snaps], dtype=np.int64)
-    return DumpRows(steps, (steps * time_step).astype(np.float64), frame, ids, fields)
+    return DumpRows(steps, (steps * time_step).astype(np.float64), frame, ids, fields, skipped)

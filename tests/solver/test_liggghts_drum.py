@@ -18,7 +18,7 @@ from drumflow import dem
 from drumflow.case import case_from_dict, load_case
 from drumflow.dem.dumps import read_series
 from drumflow.dem.stage import DemInputs
-from drumflow.errors import LostParticlesError, SolverTimeoutError
+from drumflow.errors import LostParticlesError, RunDirectoryError, SolverTimeoutError
 from drumflow.geometry import build_geometry
 from drumflow.pipeline import post_run, run_case
 from drumflow.rundir import RunDir
@@ -112,6 +112,36 @@ def test_post_recomputes_without_solver(conduction_run: tuple[dict, Path]) -> No
     n_commands = len(json.loads((out / "manifest.json").read_text())["commands"])
     run_case(case, out)
     assert len(json.loads((out / "manifest.json").read_text())["commands"]) == n_commands
+
+
+@pytest.mark.timeout(400)
+def test_post_of_a_run_still_writing_leaves_out_the_dump_cut_short(
+        conduction_run: tuple[dict, Path], tmp_path: Path) -> None:
+    """`drumflow post` on a run still going: its newest crossing dump is being written. Post
+    leaves it out, names it, and ends the series at the last complete dump (the crossings of
+    the last interval need it), instead of failing on "truncated dump"."""
+    import shutil
+
+    from drumflow.dem.dumps import dump_files
+
+    summary, out = conduction_run
+    live = tmp_path / "live"
+    shutil.copytree(out, live)
+    cross = dump_files(live / "dem" / "dumps", "cross")
+    newest = cross[-1]
+    lines = newest.read_text().splitlines(keepends=True)
+    newest.write_text("".join(lines[: 9 + max(1, (len(lines) - 9) // 2)]))  # half written
+    again = post_run(live)
+    assert again["dumps_skipped"] == [newest.name]
+    series = pd.read_csv(live / "post" / "mean_temperature.csv")
+    full = pd.read_csv(out / "post" / "mean_temperature.csv")
+    assert len(series) == len(full) - 1
+    assert series["time_s"].iloc[-1] == pytest.approx(full["time_s"].iloc[-2])
+    assert np.array_equal(series["mean_temperature_C"], full["mean_temperature_C"].iloc[:-1])
+    # A dump cut short that is not the newest is an error, named.
+    cross[-2].write_text("".join(cross[-2].read_text().splitlines(keepends=True)[:10]))
+    with pytest.raises(RunDirectoryError, match=cross[-2].name):
+        post_run(live)
 
 
 @pytest.mark.timeout(400)

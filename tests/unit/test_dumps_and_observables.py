@@ -184,3 +184,13 @@ def test_a_dump_cut_short_stays_text_and_the_others_are_packed(tmp_path: Path) -
     packed = pack_dumps(tmp_path, skip_unreadable=True)
     assert [p.name for p in packed] == ["snap.0000000030.npz"]
     assert (tmp_path / "snap.0000000020.txt").exists()
+
+
+def test_a_newest_snapshot_cut_short_is_left_out_only_when_asked(tmp_path: Path) -> None:
+    _write(tmp_path, 0, [(1, 0, 0.1, 0, 0, 0, 0, 0.004, 90), (2, 0, 0.1, 0, 0, 0, 0, 0.004, 70)])
+    (tmp_path / "snap.0000000010.txt").write_text(
+        DUMP.format(step=10, n=2, rows="1 0 0.1 0 0 0 0 0.004 89 \n"))  # LIGGGHTS mid-write
+    with pytest.raises(RunDirectoryError, match="header says 2 particles"):
+        read_series(tmp_path, time_step=0.001)
+    s = read_series(tmp_path, time_step=0.001, skip_partial_newest=True)
+    assert s.steps.tolist() == [0] and [p.name for p in s.skipped] == ["snap.0000000010.txt"]
