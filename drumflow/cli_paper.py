@@ -171,9 +171,9 @@ def paper(
     source = f"--from {root}" if from_ is not None else f"runs in {root}"
     paths = write_paper(runs, out, html, source=source)
     if as_json:
-        from drumflow.analysis.methodology import _json_safe
+        from drumflow._json import json_safe
 
-        console.print_json(json.dumps(_json_safe({
+        console.print_json(json.dumps(json_safe({
             **{k: str(v) for k, v in paths.items()},
             "models": {r.model: {"path": str(r.root), "kind": r.kind, "record": r.record,
                                  "comparison": [row.to_dict() for row in r.rows], "notes": r.notes}

@@ -42,7 +42,8 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from drumflow.analysis.methodology import _json_safe, analyse_run, write_methodology
+from drumflow._json import json_safe
+from drumflow.analysis.methodology import analyse_run, write_methodology
 from drumflow.case import load_case
 from drumflow.errors import DrumflowError, RunDirectoryError, exit_code
 from drumflow.report.animation import ANIMATION, render_animation
@@ -159,7 +160,7 @@ def ship(run_dir: Path, dest: Path, *, render_3d: bool = True, crossings_limit_m
 
     try:
         side = air_side_of_run(run.root)
-        (dest / "post" / AIR_SIDE).write_text(json.dumps(_json_safe(side), indent=2, allow_nan=False))
+        (dest / "post" / AIR_SIDE).write_text(json.dumps(json_safe(side), indent=2, allow_nan=False))
     except DrumflowError as exc:
         notes.append(f"air side (bed and airborne h) not shipped: {exc}")
 
@@ -191,7 +192,7 @@ def ship(run_dir: Path, dest: Path, *, render_3d: bool = True, crossings_limit_m
         "notes": notes,
         "files": {str(p.relative_to(dest)): p.stat().st_size for p in files},
     })
-    (dest / RUN_RECORD).write_text(json.dumps(_json_safe(record), indent=2, default=str) + "\n")
+    (dest / RUN_RECORD).write_text(json.dumps(json_safe(record), indent=2, default=str) + "\n")
     return record
 
 

@@ -38,7 +38,7 @@ from __future__ import annotations
 
 import json
 import math
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any, Literal
@@ -47,6 +47,7 @@ import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
+from drumflow._json import json_safe
 from drumflow.analysis.correlation import (
     NusseltCorrelation,
     fit_nusselt_correlation_from_runs,
@@ -308,7 +309,7 @@ class MethodologyResult:
             },
             "warnings": list(self.warnings),
         }
-        return _json_safe(data)
+        return json_safe(data)
 
 
 def exchanger_to_dict(result: ExchangerResult) -> dict[str, float]:
@@ -316,22 +317,6 @@ def exchanger_to_dict(result: ExchangerResult) -> dict[str, float]:
     out = asdict(result)
     out["balance_residual_w"] = result.balance_residual_w
     return out
-
-
-def _json_safe(value: Any) -> Any:
-    # json.dumps writes NaN as a bare NaN token, which is not JSON; use null instead.
-    if isinstance(value, Mapping):
-        return {str(k): _json_safe(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_json_safe(v) for v in value]
-    if isinstance(value, (np.floating, float)):
-        f = float(value)
-        return f if math.isfinite(f) else None
-    if isinstance(value, np.integer):
-        return int(value)
-    if isinstance(value, np.bool_):
-        return bool(value)
-    return value
 
 
 def _read_mean_temperature(path: Path) -> pd.DataFrame:

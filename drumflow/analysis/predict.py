@@ -72,6 +72,7 @@ from dataclasses import asdict, dataclass, field, replace
 from typing import Any, Literal
 
 from drumflow import air_properties as air
+from drumflow._json import json_safe
 from drumflow.analysis._validate import AnalysisInputError, check_positive
 from drumflow.analysis.correlation import CorrelationRangeWarning, NusseltCorrelation
 from drumflow.analysis.dimensionless import (
@@ -83,7 +84,6 @@ from drumflow.analysis.exchanger import ExchangerResult, solve_outlet_temperatur
 from drumflow.analysis.heat_transfer import falling_particle_area
 from drumflow.analysis.methodology import (
     MethodologyResult,
-    _json_safe,
     exchanger_to_dict,
 )
 from drumflow.case import Case
@@ -411,7 +411,7 @@ class Prediction:
             "warnings": list(self.warnings),
             "assumptions": list(self.assumptions),
         }
-        return _json_safe(data)
+        return json_safe(data)
 
 
 def _reynolds(

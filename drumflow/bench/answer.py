@@ -69,6 +69,7 @@ import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
+from drumflow._json import json_safe
 from drumflow.analysis.methodology import (
     FallingMassMode,
     MethodologyResult,
@@ -239,7 +240,7 @@ class AnswerReplay:
                 "mass_flow": float(ref["mass_flow_half_width_kg_s"]),
                 "h": float(ref["h_half_width_W_m2K"])}
         settled = self.answer_settled_s
-        return _json_safe({
+        return json_safe({
             "run_dir": str(self.run_dir),
             "case": self.case.name,
             "reference": {
@@ -754,21 +755,6 @@ def _finite_or_none(value: Any) -> float | None:
     except (TypeError, ValueError):
         return None
     return f if math.isfinite(f) else None
-
-
-def _json_safe(value: Any) -> Any:
-    # NaN is not JSON: write null.
-    if isinstance(value, dict):
-        return {str(k): _json_safe(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_json_safe(v) for v in value]
-    if isinstance(value, (bool, np.bool_)):
-        return bool(value)
-    if isinstance(value, (int, np.integer)):
-        return int(value)
-    if isinstance(value, (float, np.floating)):
-        return _finite_or_none(value)
-    return value
 
 
 # -- output ---------------------------------------------------------------------------------

@@ -42,6 +42,7 @@ import pandas as pd
 from numpy.typing import NDArray
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
+from drumflow._json import json_safe
 from drumflow.bench.answer import DEFAULT_TOLERANCE, AnswerReplay, replay_answer, settled_time
 from drumflow.errors import CaseError
 
@@ -347,21 +348,6 @@ def write_ladder(ladder: AnswerLadder, folder: Path) -> dict[str, Path]:
     folder.mkdir(parents=True, exist_ok=True)
     paths = {name.split(".")[1]: folder / name for name in LADDER_FILES}
     ladder.table.to_csv(paths["csv"], index=False, float_format="%.6g")
-    paths["json"].write_text(json.dumps(_json_safe(ladder.to_dict()), indent=2) + "\n")
+    paths["json"].write_text(json.dumps(json_safe(ladder.to_dict()), indent=2) + "\n")
     plot_ladder(ladder, paths["png"])
     return paths
-
-
-def _json_safe(value: Any) -> Any:
-    if isinstance(value, dict):
-        return {k: _json_safe(v) for k, v in value.items()}
-    if isinstance(value, list | tuple):
-        return [_json_safe(v) for v in value]
-    if isinstance(value, float | np.floating):
-        f = float(value)
-        return f if math.isfinite(f) else None
-    if isinstance(value, np.bool_):
-        return bool(value)
-    if isinstance(value, np.integer):
-        return int(value)
-    return value

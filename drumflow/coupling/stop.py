@@ -205,14 +205,16 @@ class StopMonitor:
         self.verdict = self.state(step * self.dt)
         return self.verdict.converged
 
-    def windowed(self) -> dict[str, tuple[NDArray[np.float64], NDArray[np.float64]]]:
-        """The two series over the counting window, each with its samples' durations, s."""
+    def _samples(self) -> dict[str, tuple[NDArray[np.float64], NDArray[np.float64],
+                                          NDArray[np.float64]]]:
+        """The two series over the counting window: values, durations (s) and end times (s)."""
         s = self.series
         step = np.asarray(s.step, dtype=float)
         held = np.asarray(s.steps, dtype=float) * self.dt
         t = step * self.dt
         start = float(self.rule["window_start_s"])
         h = np.asarray(s.h)
+        # An h sample is held from its update for the update's steps.
         in_h = (t >= start - 1e-9) & np.isfinite(h)
         # Crossing sample k covers (step_{k-1}, step_k]: its duration is the gap to the previous
         # sample, and it belongs to the window when that interval starts inside it.
@@ -220,37 +222,25 @@ class StopMonitor:
         c = np.asarray(s.crossings)
         in_c = (t - gap >= start - 1e-9) & np.isfinite(c) & np.isfinite(gap)
         mass = float(self.rule["particle_mass_kg"])
-        return {"h_W_m2K": (h[in_h], held[in_h]),
-                "falling_mass_flow_kg_s": (mass * c[in_c] / gap[in_c], gap[in_c])}
+        return {"h_W_m2K": (h[in_h], held[in_h], t[in_h] + held[in_h]),
+                "falling_mass_flow_kg_s": (mass * c[in_c] / gap[in_c], gap[in_c], t[in_c])}
+
+    def windowed(self) -> dict[str, tuple[NDArray[np.float64], NDArray[np.float64]]]:
+        """The two series over the counting window, each with its samples' durations, s."""
+        return {name: (v, w) for name, (v, w, _) in self._samples().items()}
 
     def intervals(self) -> dict[str, MeanInterval]:
         """Both intervals on the series so far, each from whole discharge cycles after MSER's
         cut of the start-up (:func:`drumflow.convergence.cycle_means`): the cascading bed's h
         and falling mass flow. Batch means where the rule has no ``cycle_s`` (a loop input
         written before it existed)."""
-        series = self.windowed()
+        samples = self._samples()
         cycle = self.rule.get("cycle_s")
         if cycle is None:
-            return {name: batch_means(v, w) for name, (v, w) in series.items()}
-        ends = self.sample_end_times()
+            return {name: batch_means(v, w) for name, (v, w, _) in samples.items()}
         start = float(self.rule["window_start_s"])
-        return {name: cycle_means(v, w, ends[name], float(cycle), start)
-                for name, (v, w) in series.items()}
-
-    def sample_end_times(self) -> dict[str, NDArray[np.float64]]:
-        """End time of each windowed sample, in the order of :meth:`windowed`: an h sample
-        ends when its update's heat stops being held, a crossing sample at its update."""
-        s = self.series
-        step = np.asarray(s.step, dtype=float)
-        held = np.asarray(s.steps, dtype=float) * self.dt
-        t = step * self.dt
-        start = float(self.rule["window_start_s"])
-        h = np.asarray(s.h)
-        in_h = (t >= start - 1e-9) & np.isfinite(h)
-        gap = np.r_[np.nan, np.diff(step)] * self.dt
-        c = np.asarray(s.crossings)
-        in_c = (t - gap >= start - 1e-9) & np.isfinite(c) & np.isfinite(gap)
-        return {"h_W_m2K": t[in_h] + held[in_h], "falling_mass_flow_kg_s": t[in_c]}
+        return {name: cycle_means(v, w, ends, float(cycle), start)
+                for name, (v, w, ends) in samples.items()}
 
     def state(self, time_s: float) -> ConvergenceState:
         return decide(self.intervals(), time_s, float(self.rule["tolerance"]),

@@ -38,11 +38,11 @@ from typing import Any, Literal
 import numpy as np
 import pandas as pd
 
+from drumflow._json import json_safe
 from drumflow.analysis.air_side import lumped_mean_temperature
 from drumflow.analysis.correlation import NusseltCorrelation
 from drumflow.analysis.methodology import (
     MethodologyResult,
-    _json_safe,
     analyse_run,
     fit_runs,
     write_methodology,
@@ -386,7 +386,7 @@ class PaperRun:
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready (``paper.json``'s entry for this model)."""
-        return _json_safe({
+        return json_safe({
             "model": self.model,
             "path": str(self.root),
             "kind": self.kind,
@@ -536,7 +536,7 @@ def _air_side(run: RunDir, kind: str, notes: list[str]) -> dict[str, Any] | None
         notes.append(f"bed and airborne h (last snapshot): {exc}")
         return None
     cached.parent.mkdir(parents=True, exist_ok=True)
-    cached.write_text(json.dumps(_json_safe(data), indent=2, allow_nan=False))
+    cached.write_text(json.dumps(json_safe(data), indent=2, allow_nan=False))
     return data
 
 
@@ -858,7 +858,7 @@ def build_page(runs: Sequence[PaperRun], source: str) -> tuple[str, dict[str, An
         no_fit=no_fit,
         figure9=_figure9(runs, corr),
     )
-    data = _json_safe({
+    data = json_safe({
         "generated": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
         "drumflow_version": drumflow.__version__,
         "source": source,
