@@ -401,13 +401,36 @@ def bench(
     speed_only: Annotated[
         bool, typer.Option("--speed-only", help="no reference rung: run times only")
     ] = False,
+    from_run: Annotated[
+        Path | None, typer.Option("--from", help="LIGGGHTS settings side by side from a restart of "
+                                  "this coupled run of the case (paper scale: the cascading bed)")
+    ] = None,
+    steps: Annotated[
+        int, typer.Option("--steps", min=1, help="with --from: DEM steps per variant")
+    ] = 400,
+    restart: Annotated[
+        int | None, typer.Option("--restart", min=0, help="with --from: restart step (default: newest)")
+    ] = None,
+    ranks: Annotated[
+        int | None, typer.Option("--np", min=1, help="with --from: MPI ranks (default: the case's)")
+    ] = None,
 ) -> None:
-    """Run time against error: a ladder of settings on one scene -> results.csv and pareto.png."""
+    """Run time against error: a ladder of settings on one scene -> results.csv and pareto.png.
+
+    With --from RUN_DIR: LIGGGHTS' settings (neighbour skin, rebuild rule, sorting, processor
+    grid, the conservative reference) side by side from one restart of that run -> settings.csv.
+    """
+    case = _load(case_file)
+    if from_run is not None:
+        if time_s is not None or speed_only:
+            raise typer.BadParameter("--time and --speed-only are for the ladder from a fresh "
+                                     "start, not with --from", param_hint="--from")
+        _bench_from_run(case, from_run, out, rungs, steps, restart, ranks, timeout, list_only)
+        return
     from drumflow.bench import run_bench
     from drumflow.bench.ladder import ladder, select
     from drumflow.case import case_from_dict
 
-    case = _load(case_file)
     if time_s is not None:
         data = case.model_dump(mode="json")
         data["run"]["time"] = time_s
@@ -457,6 +480,57 @@ def bench(
     if failed:
         # A rung whose run failed is a failed run (exit 1), even though the table was written.
         err_console.print(f"[bold red]failed rung(s):[/] {', '.join(failed)}", highlight=False)
+        raise typer.Exit(1)
+
+
+def _bench_from_run(case: Any, run_dir: Path, out: Path | None, rungs: str | None, steps: int,
+                    restart: int | None, ranks: int | None, timeout: float | None,
+                    list_only: bool) -> None:
+    from drumflow.bench.settings import VARIANTS, run_settings_study
+
+    if list_only:
+        for v in VARIANTS:
+            console.print(f"{v.name:22s} {v.description}", highlight=False)
+        return
+    names = [n.strip() for n in rungs.split(",") if n.strip()] if rungs else None
+    out = out or Path("runs") / "bench" / case.name / "settings"
+    ranks = ranks or case.run.processes
+    t0 = time.monotonic()
+
+    def on_variant(variant, index: int, total: int, row: dict | None) -> None:  # type: ignore[no-untyped-def]
+        elapsed = time.monotonic() - t0
+        if row is None:
+            err_console.print(f"[{index + 1}/{total}] {variant.name}: {steps} steps of the baseline's "
+                              f"time from the restart on {ranks} rank(s)... (elapsed {elapsed / 60:.1f} "
+                              "min)", highlight=False)
+            return
+        eta = elapsed / (index + 1) * (total - index - 1)
+        err_console.print(f"  {row['particle_steps_per_s']:,.0f} particle-steps/s, physics "
+                          f"{'ok' if row['physics_ok'] else 'CHANGED'} (ETA {eta / 60:.1f} min)",
+                          highlight=False)
+
+    result = run_settings_study(case, run_dir, out, steps=steps, ranks=ranks, restart_step=restart,
+                                only=names, timeout=timeout or 3600.0, on_variant=on_variant)
+    table = Table(title=f"drumflow bench {case.name} --from {run_dir} → {out}", box=box.SIMPLE)
+    cols = [("variant", "variant", "{}"), ("status", "status", "{}"),
+            ("wall s", "coupled_wall_s", "{:.1f}"), ("particle-steps/s", "particle_steps_per_s", "{:,.0f}"),
+            ("speed-up", "speedup_vs_baseline", "{:.2f}"), ("pair %", "pair_pct", "{:.0f}"),
+            ("neigh %", "neigh_pct", "{:.0f}"), ("walls %", "walls_pct", "{:.0f}"),
+            ("physics", "physics_ok", "{}")]
+    for title, _, _ in cols:
+        table.add_column(title)
+    for _, r in result.table.iterrows():
+        cells = []
+        for _, key, fmt in cols:
+            v = r.get(key)
+            cells.append("" if v is None or (isinstance(v, float) and v != v) else fmt.format(v)[:40])
+        table.add_row(*cells)
+    console.print(table)
+    if result.resumed:
+        console.print(f"kept from the interrupted study: {', '.join(result.resumed)}", highlight=False)
+    console.print(f"written: {result.csv}, {result.json}", highlight=False)
+    if result.failed:
+        err_console.print(f"[bold red]failed variant(s):[/] {', '.join(result.failed)}", highlight=False)
         raise typer.Exit(1)
 
 

@@ -16,6 +16,7 @@ from typing import Any
 
 import typer
 from rich.console import Console
+from rich.markup import escape
 
 from drumflow.errors import DrumflowError, exit_code
 
@@ -31,7 +32,8 @@ def guard(console: Console | None = None) -> Iterator[None]:
     try:
         yield
     except DrumflowError as exc:
-        out.print(f"[bold red]error:[/] {exc}", highlight=False)
+        # Escaped: an error's text is plain (a list in brackets, a TOML [section]), not markup.
+        out.print(f"[bold red]error:[/] {escape(str(exc))}", highlight=False)
         raise typer.Exit(exit_code(exc)) from None
     except KeyboardInterrupt as exc:
         out.print("interrupted")

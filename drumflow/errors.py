@@ -61,6 +61,11 @@ class SweepError(CaseError):
         return str(self.args[0])
 
 
+class SettingsStudyError(DrumflowError, ValueError):
+    """A run directory cannot be studied by ``drumflow bench --from`` (no restart, no air
+    coupling, a deck of another form, a run of another scene, an unknown variant)."""
+
+
 class SlurmError(DrumflowError, RuntimeError):
     """A SLURM command failed (sbatch refused the job, squeue could not reach the controller)."""
 

@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import platform
 import time
 from pathlib import Path
 from typing import Any
@@ -49,6 +50,18 @@ def software_versions() -> dict[str, Any]:
     from drumflow.runner import LaunchProfile
 
     return LaunchProfile().software_versions()
+
+
+def cpu_model() -> str:
+    """The processor's model name (``/proc/cpuinfo``; ``platform.processor()`` elsewhere), for
+    the machine line of benchmarks and reports."""
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor() or "unknown"
 
 
 class RunDir:

@@ -134,7 +134,7 @@ def processors_grid(case: Case, processes: int) -> str:
     The bed is uniform along the axis, so slabs along z carry equal loads; across the drum
     (x) the load follows the bed, which the rotation piles up on the rising side. Measured on
     paper model two at 3.47 s (299,164 particles, 1 m, 2 ranks, 204 steps from one restart,
-    ``scripts/liggghts_settings_study.py``): the split along z ran 1.61 times faster than the
+    ``drumflow bench --from``): the split along z ran 1.61 times faster than the
     split along x (878k against 546k particle-steps per second; 1 rank: 438k), with
     communication and waiting down from 27 % to 8 % of the loop. A thin slice (the smoke drum,
     paper model one at 2 ranks: under :data:`AXIAL_SPLIT_MIN_DIAMETERS` diameters per rank)

@@ -168,13 +168,21 @@ def _stage_key(case: Case, inputs: DemInputs) -> str:
     return key
 
 
-def _latest_restart(folder: Path) -> tuple[Path, int] | None:
-    best: tuple[Path, int] | None = None
+def restart_files(folder: Path) -> list[tuple[int, Path]]:
+    """The ``drum.STEP.restart`` files of ``folder`` as (step, path), oldest first (other
+    files, such as ``final.restart``, are not listed)."""
+    found: list[tuple[int, Path]] = []
     for p in folder.glob("drum.*.restart"):
-        m = re.search(r"drum\.(\d+)\.restart$", p.name)
-        if m and (best is None or int(m.group(1)) > best[1]):
-            best = (p, int(m.group(1)))
-    return best
+        m = re.fullmatch(r"drum\.(\d+)\.restart", p.name)
+        if m:
+            found.append((int(m.group(1)), p))
+    return sorted(found)
+
+
+def latest_restart(folder: Path) -> tuple[Path, int] | None:
+    """The newest ``drum.STEP.restart`` of ``folder`` and its step, or None."""
+    found = restart_files(folder)
+    return (found[-1][1], found[-1][0]) if found else None
 
 
 #: Restart files kept in ``dem/restart``: the newest resumes the run; the one before it is a
@@ -193,12 +201,7 @@ def prune_restarts(folder: Path, keep: int = KEEP_RESTARTS, protect: Path | None
     from, which its deck names and the resume check reads) are not touched. Returns the removed
     paths.
     """
-    steps: list[tuple[int, Path]] = []
-    for p in folder.glob("drum.*.restart"):
-        m = re.search(r"drum\.(\d+)\.restart$", p.name)
-        if m:
-            steps.append((int(m.group(1)), p))
-    steps.sort()
+    steps = restart_files(folder)
     removed = [p for _, p in steps[:max(0, len(steps) - keep)]
                if protect is None or p.resolve() != protect.resolve()]
     for p in removed:
@@ -231,7 +234,7 @@ def _prepare_workdir(case: Case, rundir: RunDir, inputs: DemInputs, key: str) ->
     rundir.dem_restart.mkdir(parents=True, exist_ok=True)
     resume = None
     if inputs.steps is None and rundir.manifest.get("dem_key") == key:
-        resume = _latest_restart(rundir.dem_restart)
+        resume = latest_restart(rundir.dem_restart)
     if resume is None:
         stale = [*rundir.dem_dumps.glob("*.txt"), *rundir.dem_dumps.glob("*.npz*"),
                  *rundir.dem_restart.glob("*.restart"),
@@ -246,7 +249,7 @@ def _prepare_workdir(case: Case, rundir: RunDir, inputs: DemInputs, key: str) ->
     return resume
 
 
-def _write_deck(case: Case, rundir: RunDir, inputs: DemInputs,
+def write_deck(case: Case, rundir: RunDir, inputs: DemInputs,
                 resume: tuple[Path, int] | None) -> tuple[str, dict[str, Any]]:
     """Render the deck (fresh or resume) and record what it chose; return its name and context."""
     geometry = inputs.geometry
@@ -273,7 +276,7 @@ def _write_deck(case: Case, rundir: RunDir, inputs: DemInputs,
     return deck_name, context
 
 
-def _finished_loop(returncode: int, lines: list[str]) -> str | None:
+def finished_loop(returncode: int, lines: list[str]) -> str | None:
     """A runner ``check``: LIGGGHTS can exit 0 after losing atoms or before its run loop."""
     lost = next((ln for ln in reversed(lines) if _LOST_RE.search(ln)), None)
     if lost:
@@ -350,7 +353,7 @@ def _launch(case: Case, rundir: RunDir, runner: Runner, inputs: DemInputs, deck_
     t0 = time.perf_counter()
     try:
         runner.run("liggghts", command, work, log, timeout=inputs.timeout, on_line=watcher,
-                   check=_finished_loop, follow=own_log)
+                   check=finished_loop, follow=own_log)
     except (UnstableRunError, LostParticlesError):
         rundir.record("stability", watcher.record(stopped=True))
         raise
@@ -391,7 +394,7 @@ def run(case: Case, rundir: RunDir, runner: Runner, inputs: DemInputs) -> DemRes
     if done:
         return DemResult(**done["result"])
     resume = _prepare_workdir(case, rundir, inputs, key)
-    deck_name, context = _write_deck(case, rundir, inputs, resume)
+    deck_name, context = write_deck(case, rundir, inputs, resume)
     suffix = "" if resume is None else f".resume-{resume[1]}"
     watcher, log, wall = _launch(case, rundir, runner, inputs, deck_name, context, suffix,
                                  None if resume is None else resume[0])

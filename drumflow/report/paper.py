@@ -28,7 +28,6 @@ import csv
 import json
 import math
 import os
-import platform
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -71,7 +70,7 @@ from drumflow.report.html import (
     _Table,
     _table8,
 )
-from drumflow.rundir import RunDir
+from drumflow.rundir import RunDir, cpu_model
 
 __all__ = [
     "AT_S",
@@ -113,16 +112,6 @@ def _read_json(path: Path) -> dict[str, Any] | None:
     except (OSError, ValueError):
         return None
     return data if isinstance(data, dict) else None
-
-
-def _cpu_model() -> str:
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                return line.split(":", 1)[1].strip()
-    except OSError:
-        pass
-    return platform.processor() or "unknown"
 
 
 def _time_step(run: RunDir) -> float | None:
@@ -215,7 +204,7 @@ def run_record(root: Path | str) -> dict[str, Any]:
             "platform": versions.get("platform"),
             "processes": run.manifest.get("processes"),
             "cpus": os.cpu_count(),
-            "cpu": _cpu_model(),
+            "cpu": cpu_model(),
         },
         "versions": {k: versions.get(k) for k in ("liggghts", "openfoam", "python")},
     }

@@ -1,39 +1,29 @@
 """The coupled loop's profile and the LIGGGHTS settings study on the real solver (tiny drum).
 
 One short coupled run of the tiny drum with plug-flow air (no OpenFOAM); then `drumflow profile`
-on it, and scripts/liggghts_settings_study.py from its restart on one rank.
+on it, and `drumflow bench CASE --from RUN_DIR` (the LIGGGHTS settings study) from its restart
+on one rank.
 """
 
 from __future__ import annotations
 
-import importlib.util
 import json
+import re
 import subprocess
 import sys
 from pathlib import Path
-from typing import Any
 
 import pandas as pd
 import pytest
-from support.solvers import LIGGGHTS, ROOT, requires_solver
+from support.solvers import LIGGGHTS, requires_solver
 
 pytestmark = [pytest.mark.solver, pytest.mark.timeout(400), requires_solver(*LIGGGHTS)]
 
-STUDY = ROOT / "scripts" / "liggghts_settings_study.py"
 #: LIGGGHTS prints each time and percentage with %g (6 significant digits): a percentage below
 #: 100 is off by at most 5e-5, so six categories add up to 100 within 3e-4 (LIGGGHTS' Other is
 #: the loop time minus the rest, so before rounding they add up exactly). 1e-3 leaves room and
 #: still catches a category lost or counted twice.
 ROUNDING = 1e-3
-
-
-def _study_variants() -> list[Any]:
-    spec = importlib.util.spec_from_file_location("liggghts_settings_study", STUDY)
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module  # its dataclasses look their module up there
-    spec.loader.exec_module(module)
-    return list(module.VARIANTS)
 
 
 @pytest.fixture(scope="module")
@@ -85,13 +75,21 @@ def test_profile_of_a_coupled_run(run: Path) -> None:
     assert len(pd.read_csv(run / "post" / "profile.csv")) == len(table)
 
 
+def _bench_from(run: Path, case_file: Path, out: Path, *extra: str) -> subprocess.CompletedProcess[str]:
+    return subprocess.run([sys.executable, "-m", "drumflow.cli", "bench", str(case_file), "--from", str(run),
+                           "--steps", "100", "--np", "1", "--out", str(out), *extra],
+                          capture_output=True, text=True, timeout=350, check=False)
+
+
 def test_settings_study_from_the_restart(run: Path, tmp_path: Path) -> None:
-    out = tmp_path / "study" / "settings.csv"
-    proc = subprocess.run([sys.executable, str(STUDY), str(run), "--steps", "100", "--np", "1",
-                           "--out", str(out)], capture_output=True, text=True, timeout=350, check=False)
+    from drumflow.bench.settings import VARIANTS
+
+    study = tmp_path / "study"
+    out = study / "settings.csv"
+    proc = _bench_from(run, run / "case.toml", study)
     assert proc.returncode == 0, proc.stderr[-3000:]
     table = pd.read_csv(out).set_index("variant")
-    variants = _study_variants()
+    variants = VARIANTS
     assert list(table.index) == [v.name for v in variants]
     for v in variants:
         row = table.loc[v.name]
@@ -123,4 +121,30 @@ def test_settings_study_from_the_restart(run: Path, tmp_path: Path) -> None:
     assert log["time_s"].iloc[0] == pytest.approx(start * dt_base["time_step"], rel=1e-9)
     assert spec["interval"] == 2 * dt_base["interval"]  # the same air-update period in time
     meta = json.loads(out.with_suffix(".json").read_text())
-    assert meta["steps"] == 100 and meta["machine"]["cpus"] >= 1
+    assert meta["steps"] == 100 and meta["machine"]["cpus"] >= 1 and meta["resumed"] == []
+
+    # Run again (as after an interrupt): every measured variant is kept, none is rerun.
+    before = {p: p.stat().st_mtime_ns for p in study.glob("variants/*/dem/log.liggghts")}
+    again = _bench_from(run, run / "case.toml", study)
+    assert again.returncode == 0, again.stderr[-3000:]
+    measured = [v.name for v in variants if v.min_ranks == 1]
+    assert json.loads(out.with_suffix(".json").read_text())["resumed"] == measured
+    assert {p: p.stat().st_mtime_ns for p in study.glob("variants/*/dem/log.liggghts")} == before
+    assert pd.read_csv(out).set_index("variant")["coupled_wall_s"].equals(table["coupled_wall_s"])
+
+
+def test_settings_study_refuses_another_scene(run: Path, tmp_path: Path) -> None:
+    # A case with other particles is another scene: one message naming the section, exit 2,
+    # before any solver starts.
+    text = (run / "case.toml").read_text()
+    other = tmp_path / "other.toml"
+    head, particles = text.split("[particles]", 1)
+    particles = re.sub(r"(?m)^diameter\s*=\s*([0-9.e-]+)",
+                       lambda m: f"diameter = {float(m.group(1)) * 1.1:.6g}", particles, count=1)
+    other.write_text(f"{head}[particles]{particles}")
+    assert other.read_text() != text
+    proc = _bench_from(run, other, tmp_path / "study")
+    assert proc.returncode == 2, proc.stderr
+    assert "another scene" in proc.stderr and "particles" in proc.stderr
+    assert "Traceback" not in proc.stderr
+    assert not (tmp_path / "study" / "variants").exists()

@@ -35,6 +35,7 @@ from drumflow.errors import (
     LostParticlesError,
     RenderError,
     RunDirectoryError,
+    SettingsStudyError,
     SolverError,
     SolverTimeoutError,
     exit_code,
@@ -116,6 +117,22 @@ def test_report_of_a_directory_that_is_not_a_run_writes_nothing(tmp_path: Path) 
 )
 def test_the_rule_follows_the_base_class(error: BaseException, code: int) -> None:
     assert exit_code(error) == code
+
+
+def test_an_error_in_brackets_is_printed_as_written() -> None:
+    # Regression: the guard printed errors as rich markup, so "[particles]" vanished from
+    # `drumflow bench --from`'s message naming the case sections that differ.
+    import io
+
+    from rich.console import Console
+
+    from drumflow.cli_guard import guard
+
+    buffer = io.StringIO()
+    with pytest.raises(typer.Exit) as exit_info, guard(Console(file=buffer, width=200)):
+        raise SettingsStudyError("differs in [particles, air]; see [bold]")
+    assert exit_info.value.exit_code == EXIT_BAD_INPUT
+    assert "differs in [particles, air]; see [bold]" in buffer.getvalue()
 
 
 def test_every_error_class_lives_in_errors_py() -> None:

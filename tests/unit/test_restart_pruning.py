@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from drumflow.dem.stage import _latest_restart, prune_restarts
+from drumflow.dem.stage import latest_restart, prune_restarts
 
 
 def _touch(folder: Path, *names: str) -> None:
@@ -22,7 +22,7 @@ def test_keeps_the_newest_by_step_number_not_by_name(tmp_path: Path) -> None:
     assert sorted(p.name for p in removed) == ["drum.1666.restart", "drum.9996.restart"]
     left = sorted(p.name for p in tmp_path.iterdir())
     assert left == ["drum.11662.restart", "drum.13328.restart", "final.restart", "notes.txt"]
-    latest = _latest_restart(tmp_path)
+    latest = latest_restart(tmp_path)
     assert latest is not None and latest[1] == 13328
 
 

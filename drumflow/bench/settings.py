@@ -1,24 +1,23 @@
-"""LIGGGHTS settings side by side, from one restart of a coupled run (drumflow issue 11, lever 4).
+"""LIGGGHTS settings side by side from one restart of a coupled run (issue 11, levers 3 and 4).
 
-How to use::
+``drumflow bench CASE --from RUN_DIR`` runs every :data:`VARIANTS` entry (the one list of what
+is compared) from the same restart file of RUN_DIR (the newest ``dem/restart/drum.STEP.restart``
+unless ``restart_step``): ``steps`` DEM steps through the real coupling loop
+(``python -m drumflow.coupling.driver`` under mpirun, through :class:`drumflow.runner.Runner`:
+drag and heat included, a timing breakdown after every coupling interval), each in its own
+folder under ``OUT/variants``, read back with :func:`drumflow.bench.profile.profile_run`.
+Written: ``settings.csv`` (one row per variant: status, loop and wall seconds, steps/s,
+particle-steps/s, the breakdown, speed-up over the baseline, and the physics check) and
+``settings.json`` beside it with the variants, the tolerances and the machine.
 
-    .venv/bin/python scripts/liggghts_settings_study.py RUN_DIR [--steps 400] [--np 2]
-        [--out runs/settings_study/RUN/settings.csv] [--scratch DIR] [--restart STEP]
-        [--only baseline,skin_x2] [--timeout 3600]
-
-Every variant (:data:`VARIANTS`, the one list of what is compared) starts from the same restart
-file of RUN_DIR (the newest ``dem/restart/drum.STEP.restart`` unless ``--restart``), runs
-``--steps`` DEM steps through the real coupling loop (``python -m drumflow.coupling.driver``
-under mpirun, through :class:`drumflow.runner.Runner`: drag and heat included, a timing
-breakdown after every coupling interval) in its own folder under the scratch directory, and is
-read back with :func:`drumflow.bench.profile.profile_run`. Written: the CSV (one row per
-variant: status, loop and wall seconds, steps/s, particle-steps/s, the breakdown, speed-up
-over the baseline, and the physics check) and a JSON beside it with the variants, the
-tolerances and the machine.
+Why from a restart: at the paper's scale the cost per step depends on the state of the bed
+(the rate falls 2.5 times once the bed forms and again 2 times once the curtain runs), so a
+comparison from a fresh start measures the wrong state; the paper runs' restarts hold the
+cascading bed.
 
 The deck is RUN_DIR/dem/in.drum.resume when the run was resumed, else one rendered the way the
-DEM stage renders resume decks (:func:`drumflow.dem.stage._write_deck`). The baseline uses the
-default processor grid for ``--np`` (:func:`drumflow.dem.deck.processors_grid`).
+DEM stage renders resume decks (:func:`drumflow.dem.stage.write_deck`). The baseline uses the
+default processor grid for the rank count (:func:`drumflow.dem.deck.processors_grid`).
 
 Physics check: after the steps, the mass-weighted mean temperature and the kinetic energy must
 match the baseline's within noise. A changed neighbour list or atom order changes round-off,
@@ -28,35 +27,40 @@ which a granular bed amplifies, but not the physics: the temperatures are held t
 variant that misses contacts (a skin too small for its rebuild rule) changes both by far more,
 and LIGGGHTS counts its "dangerous builds", which the CSV also shows.
 
-Timings are only comparable on an otherwise idle machine.
+Timings are only comparable on an otherwise idle machine, so the variants run one after the
+other in one call. An interrupted study resumes: variants already measured from the same
+restart, step count and rank count are kept (``settings.json`` names them as resumed).
 """
 
 from __future__ import annotations
 
-import argparse
 import json
 import math
 import re
 import shutil
-import sys
 import time
-from dataclasses import asdict, dataclass
+from collections.abc import Callable
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
 import pandas as pd
 
 from drumflow.bench.profile import profile_run
-from drumflow.case import load_case
+from drumflow.case import Case, load_case
 from drumflow.coupling.spec import COUPLING_FILE, CouplingSpec, driver_command
 from drumflow.dem.deck import processors_grid
-from drumflow.dem.stage import DemInputs, _finished_loop, _latest_restart, _write_deck
+from drumflow.dem.stage import DemInputs, finished_loop, latest_restart, write_deck
 from drumflow.dem.thermo import read_thermo
-from drumflow.errors import DrumflowError
+from drumflow.errors import DrumflowError, SettingsStudyError
 from drumflow.geometry.stage import GeometryResult
-from drumflow.report.paper import _cpu_model
-from drumflow.rundir import RunDir
+from drumflow.rundir import RunDir, cpu_model
 from drumflow.runner import Runner
+
+#: The case sections that make the DEM scene: a case may differ from the run's in anything
+#: else (its name, run length, output, plant block) and still be studied from its restarts.
+SCENE_SECTIONS = ("drum", "lifters", "particles", "contacts", "air")
+TABLE = "settings.csv"
 
 
 @dataclass(frozen=True)
@@ -136,14 +140,10 @@ KINETIC_ENERGY_TOLERANCE = 0.05
 RESTART_INPUT = "input"
 
 
-class StudyError(DrumflowError, ValueError):
-    """The run directory cannot be studied (no restart, not coupled, a deck of another form)."""
-
-
 def _replace_line(deck: str, pattern: str, line: str) -> str:
     new, count = re.subn(pattern, line, deck, flags=re.M)
     if count != 1:
-        raise StudyError(f"deck: expected one line matching {pattern!r}, found {count}")
+        raise SettingsStudyError(f"deck: expected one line matching {pattern!r}, found {count}")
     return new
 
 
@@ -152,7 +152,7 @@ def _scale_value(deck: str, keyword: str, factor: float, fmt: str, suffix: str =
     times ``factor``, written with ``fmt``."""
     m = re.search(rf"^{keyword}\s+(\S+){suffix}\s*$", deck, flags=re.M)
     if m is None:
-        raise StudyError(f"deck: no `{keyword} VALUE` line")
+        raise SettingsStudyError(f"deck: no `{keyword} VALUE` line")
     value = fmt.format(float(m.group(1)) * factor)
     return _replace_line(deck, rf"^{keyword}\s+.*$", f"{keyword:<16}{value}")
 
@@ -166,7 +166,7 @@ def apply_variant(deck: str, variant: Variant, ranks: int) -> str:
     if variant.atom_modify is not None:
         m = re.search(r"^read_restart\s+.*$", deck, flags=re.M)
         if m is None:
-            raise StudyError("deck: no read_restart line")
+            raise SettingsStudyError("deck: no read_restart line")
         deck = deck[:m.end()] + f"\natom_modify     {variant.atom_modify}" + deck[m.end():]
     if variant.processors is not None:
         deck = _replace_line(deck, r"^processors\s+.*$",
@@ -178,13 +178,13 @@ def apply_variant(deck: str, variant: Variant, ranks: int) -> str:
                    r"axis (\S+ \S+ \S+) omega (\S+)\s*$")
         m = re.search(pattern, deck, flags=re.M)
         if m is None:
-            raise StudyError("deck: no static shell (surface_ang_vel) to turn into a moving mesh")
+            raise SettingsStudyError("deck: no static shell (surface_ang_vel) to turn into a moving mesh")
         period = 2.0 * math.pi / float(m.group(4))
         deck = _replace_line(deck, r"^fix shell all mesh/surface .*$",
                              f"fix shell all mesh/surface file {m.group(1)} type 2")
         walls = re.search(r"^fix walls all wall/gran .*$", deck, flags=re.M)
         if walls is None:
-            raise StudyError("deck: no `fix walls` line")
+            raise SettingsStudyError("deck: no `fix walls` line")
         line = (f"\nfix spin_shell all move/mesh mesh shell rotate origin {m.group(2)} axis {m.group(3)} "
                 f"period {period:.12g}")
         deck = deck[:walls.end()] + line + deck[walls.end():]
@@ -198,13 +198,13 @@ def variant_steps(steps: int, variant: Variant) -> int:
 
 def _restart(rundir: RunDir, step: int | None) -> tuple[Path, int]:
     if step is None:
-        newest = _latest_restart(rundir.dem_restart)
+        newest = latest_restart(rundir.dem_restart)
         if newest is None:
-            raise StudyError(f"{rundir.dem_restart}: no drum.STEP.restart file")
+            raise SettingsStudyError(f"{rundir.dem_restart}: no drum.STEP.restart file")
         return newest
     path = rundir.dem_restart / f"drum.{step}.restart"
     if not path.is_file():
-        raise StudyError(f"{path}: no such restart file")
+        raise SettingsStudyError(f"{path}: no such restart file")
     return path, step
 
 
@@ -230,8 +230,8 @@ def baseline_deck(rundir: RunDir, restart_step: int, ranks: int, scratch: Path,
     source = RunDir(scratch / "_deck")
     source.dem.mkdir(parents=True, exist_ok=True)
     fake_restart = source.dem / restart  # only its name goes into the deck
-    deck_name, _ = _write_deck(case, source, inputs, (fake_restart, restart_step))
-    return (source.dem / deck_name).read_text(), "rendered from the case (drumflow.dem.stage._write_deck)"
+    deck_name, _ = write_deck(case, source, inputs, (fake_restart, restart_step))
+    return (source.dem / deck_name).read_text(), "rendered from the case (drumflow.dem.stage.write_deck)"
 
 
 def _prepare(folder: Path, rundir: RunDir, restart: Path, deck: str, driver: dict[str, Any],
@@ -302,32 +302,145 @@ def physics_check(row: dict[str, Any], base: dict[str, Any]) -> dict[str, Any]:
 
 def machine_info(runner: Runner, ranks: int) -> dict[str, Any]:
     versions = runner.profile.software_versions()
-    return {"platform": versions["platform"], "cpu": _cpu_model(), "cpus": runner.profile.cores,
+    return {"platform": versions["platform"], "cpu": cpu_model(), "cpus": runner.profile.cores,
             "ranks": ranks, "liggghts": versions["liggghts"], "openmpi": versions["openmpi"],
             "python": versions["python"]}
 
 
-def run_study(run_dir: Path, steps: int, ranks: int, out: Path, scratch: Path,
-              restart_step: int | None = None, only: list[str] | None = None,
-              timeout: float = 3600.0) -> pd.DataFrame:
-    """Run the variants one after the other; write ``out`` (CSV) and its JSON; return the table."""
+@dataclass
+class SettingsStudy:
+    """What :func:`run_settings_study` measured and wrote.
+
+    Attributes
+    ----------
+    table
+        One row per variant (``status`` is ``ok``, ``skipped: ...`` or ``failed: ...``).
+    csv, json
+        The files written.
+    resumed
+        Variants kept from an earlier, interrupted call.
+    """
+
+    table: pd.DataFrame
+    csv: Path
+    json: Path
+    resumed: list[str] = field(default_factory=list)
+
+    @property
+    def failed(self) -> list[str]:
+        """Names of the variants whose run failed."""
+        return [str(r["variant"]) for _, r in self.table.iterrows()
+                if str(r["status"]).startswith("failed")]
+
+
+def check_scene(case: Case, rundir: RunDir) -> None:
+    """Refuse a run directory whose DEM scene is not ``case``'s (:data:`SCENE_SECTIONS`)."""
+    if not rundir.case_toml.is_file():
+        raise SettingsStudyError(f"{rundir.case_toml}: missing; --from needs a run directory "
+                                 "written by `drumflow run`")
+    theirs = load_case(rundir.case_toml)
+    differ = [s for s in SCENE_SECTIONS if case.section_hash(s) != theirs.section_hash(s)]
+    if differ:
+        raise SettingsStudyError(
+            f"{rundir.root} holds a run of another scene: its case ({theirs.name}) differs from "
+            f"{case.name} in [{', '.join(differ)}]; pass the run's own case file "
+            f"({rundir.case_toml}) or another run directory")
+
+
+def _earlier_rows(out: Path, meta: dict[str, Any]) -> dict[str, dict[str, Any]]:
+    """Measured rows of an interrupted study with the same restart, steps and ranks."""
+    json_path = out / TABLE.replace(".csv", ".json")
+    try:
+        old = json.loads(json_path.read_text())
+    except (OSError, ValueError):
+        return {}
+    same = all(old.get(k) == meta[k] for k in ("run_dir", "restart_step", "steps", "ranks"))
+    if not same:
+        return {}
+    return {str(r["variant"]): r for r in old.get("results", []) if r.get("status") == "ok"}
+
+
+def run_settings_study(case: Case, run_dir: Path, out: Path, steps: int = 400, ranks: int = 2,
+                       restart_step: int | None = None, only: list[str] | None = None,
+                       timeout: float = 3600.0,
+                       on_variant: Callable[[Variant, int, int, dict[str, Any] | None], None] | None = None,
+                       ) -> SettingsStudy:
+    """Run the variants one after the other from one restart of ``run_dir``.
+
+    Parameters
+    ----------
+    case
+        The scene; must match the run's (:func:`check_scene`).
+    run_dir
+        A coupled run (air field) with ``dem/restart/drum.STEP.restart`` files.
+    out
+        Folder for ``settings.csv``, ``settings.json`` and the variants' runs (``variants/``).
+    steps
+        DEM steps of the baseline; a time-step variant covers the same simulated time.
+    ranks
+        MPI ranks of every variant.
+    restart_step
+        The restart to start from (default: the newest).
+    only
+        Variant names (default: all); the baseline is always run, first.
+    timeout
+        Solver time limit per variant, s.
+    on_variant
+        Called before each variant (``row`` None) and after it (its row), with its index and
+        the number of variants: progress for the CLI.
+
+    Raises
+    ------
+    SettingsStudyError
+        Bad input: not a coupled run, no such restart, another scene, an unknown variant.
+    drumflow.errors.SolverError
+        The baseline's run failed (a later variant's failure is a ``failed:`` row).
+    """
+    if steps < 1:
+        raise SettingsStudyError(f"steps = {steps}: must be at least 1")
+    if ranks < 1:
+        raise SettingsStudyError(f"ranks = {ranks}: must be at least 1")
+    known = [v.name for v in VARIANTS]
+    unknown = [n for n in (only or []) if n not in known]
+    if unknown:
+        raise SettingsStudyError(f"unknown variant(s) {', '.join(unknown)}; known: {', '.join(known)}")
     rundir = RunDir.existing(run_dir)
+    check_scene(case, rundir)
     driver_path = rundir.dem / COUPLING_FILE
     if not driver_path.is_file():
-        raise StudyError(f"{driver_path}: missing; the study runs the coupling loop, so RUN_DIR "
-                         "must be a run with air")
+        raise SettingsStudyError(f"{driver_path}: missing; the study runs the coupling loop, so "
+                                 "the run must have air (air.model 'uniform' or 'cfd')")
     driver = json.loads(driver_path.read_text())
     restart, start = _restart(rundir, restart_step)
+    scratch = out / "variants"
     scratch.mkdir(parents=True, exist_ok=True)
     deck, deck_source = baseline_deck(rundir, start, ranks, scratch, driver)
-    variants = [v for v in VARIANTS if only is None or v.name in only]
-    if not variants or variants[0].name != "baseline":
-        raise StudyError("the baseline must run (first): it is the physics check's reference")
+    variants = [v for v in VARIANTS if v.name == "baseline" or only is None or v.name in only]
+    meta: dict[str, Any] = {"run_dir": str(rundir.root.resolve()), "restart": str(restart),
+                            "restart_step": start, "steps": steps, "ranks": ranks}
+    earlier = _earlier_rows(out, meta)
     runner = Runner()
+    meta.update(deck=deck_source, variants=[asdict(v) for v in variants],
+                tolerances={"temperature_of_change": TEMPERATURE_TOLERANCE,
+                            "temperature_floor_K": TEMPERATURE_FLOOR_K,
+                            "kinetic_energy_relative": KINETIC_ENERGY_TOLERANCE},
+                machine=machine_info(runner, ranks))
     rows: list[dict[str, Any]] = []
+    resumed: list[str] = []
     base: dict[str, Any] | None = None
     baseline_grid = processors_grid(load_case(rundir.case_toml), ranks)
-    for variant in variants:
+    csv_path, json_path = out / TABLE, out / TABLE.replace(".csv", ".json")
+
+    def write() -> pd.DataFrame:
+        # After every variant, so an interrupted study keeps what it measured.
+        table = pd.DataFrame(rows)
+        table.to_csv(csv_path, index=False, float_format="%.6g")
+        json_path.write_text(json.dumps({**meta, "resumed": resumed,
+                                         "results": json.loads(table.to_json(orient="records"))},
+                                        indent=2))
+        return table
+
+    for index, variant in enumerate(variants):
         row: dict[str, Any] = {"variant": variant.name, "description": variant.description}
         grid = variant.processors.format(np=ranks) if variant.processors else None
         if ranks < variant.min_ranks:
@@ -336,77 +449,35 @@ def run_study(run_dir: Path, steps: int, ranks: int, out: Path, scratch: Path,
         if grid is not None and grid == baseline_grid:
             rows.append({**row, "status": f"skipped: the baseline's grid ({grid})"})
             continue
-        folder = scratch / variant.name
-        n_steps = variant_steps(steps, variant)
-        _prepare(folder, rundir, restart, apply_variant(deck, variant, ranks), driver, start + n_steps,
-                 variant.time_step_factor, start)
-        sys.stderr.write(f"{variant.name}: {n_steps} steps from step {start} on {ranks} rank(s)...\n")
-        t0 = time.perf_counter()
-        try:
-            record = runner.run("liggghts", driver_command(runner.profile, ranks, COUPLING_FILE),
-                                folder / "dem", folder / "dem" / "liggghts.out", timeout=timeout,
-                                check=_finished_loop, follow=folder / "dem" / "log.liggghts")
-        except DrumflowError as exc:
-            if base is None:
-                raise
-            rows.append({**row, "status": f"failed: {exc}"[:300]})
-            continue
-        row.update(status="ok", wall_s=record.wall_time_s or time.perf_counter() - t0,
-                   time_step_factor=variant.time_step_factor, **_measure(folder, n_steps))
+        if variant.name in earlier:
+            row = earlier[variant.name]
+            resumed.append(variant.name)
+        else:
+            if on_variant is not None:
+                on_variant(variant, index, len(variants), None)
+            folder = scratch / variant.name
+            n_steps = variant_steps(steps, variant)
+            _prepare(folder, rundir, restart, apply_variant(deck, variant, ranks), driver,
+                     start + n_steps, variant.time_step_factor, start)
+            t0 = time.perf_counter()
+            try:
+                record = runner.run("liggghts", driver_command(runner.profile, ranks, COUPLING_FILE),
+                                    folder / "dem", folder / "dem" / "liggghts.out", timeout=timeout,
+                                    check=finished_loop, follow=folder / "dem" / "log.liggghts")
+            except DrumflowError as exc:
+                if base is None:
+                    raise
+                rows.append({**row, "status": f"failed: {exc}"[:300]})
+                write()
+                continue
+            row.update(status="ok", wall_s=record.wall_time_s or time.perf_counter() - t0,
+                       time_step_factor=variant.time_step_factor, **_measure(folder, n_steps))
         if base is None:
             base = row
         row.update(physics_check(row, base))
         row["speedup_vs_baseline"] = base["coupled_wall_s"] / row["coupled_wall_s"]
         rows.append(row)
-        sys.stderr.write(f"  {row['particle_steps_per_s']:,.0f} particle-steps/s, physics "
-                         f"{'ok' if row['physics_ok'] else 'CHANGED'}\n")
-    table = pd.DataFrame(rows)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    table.to_csv(out, index=False, float_format="%.6g")
-    meta = {"run_dir": str(rundir.root), "restart": str(restart), "restart_step": start, "steps": steps,
-            "ranks": ranks, "deck": deck_source, "scratch": str(scratch.resolve()),
-            "variants": [asdict(v) for v in variants],
-            "tolerances": {"temperature_of_change": TEMPERATURE_TOLERANCE,
-                           "temperature_floor_K": TEMPERATURE_FLOOR_K,
-                           "kinetic_energy_relative": KINETIC_ENERGY_TOLERANCE},
-            "machine": machine_info(runner, ranks),
-            "results": json.loads(table.to_json(orient="records"))}
-    out.with_suffix(".json").write_text(json.dumps(meta, indent=2))
-    return table
-
-
-def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("run_dir", type=Path, help="run directory of a coupled run with restart files")
-    parser.add_argument("--steps", type=int, default=400, help="DEM steps per variant (default 400)")
-    parser.add_argument("--np", dest="ranks", type=int, default=2, help="MPI ranks (default 2)")
-    parser.add_argument("--out", type=Path, default=None,
-                        help="CSV to write (default runs/settings_study/RUN/settings.csv); JSON beside it")
-    parser.add_argument("--scratch", type=Path, default=None,
-                        help="folder for the variants' runs (default: beside --out, variants/)")
-    parser.add_argument("--restart", type=int, default=None, help="restart step (default: the newest)")
-    parser.add_argument("--only", default=None, help="comma-separated variant names (baseline first)")
-    parser.add_argument("--timeout", type=float, default=3600.0, help="time limit per variant, s")
-    args = parser.parse_args(argv)
-    if args.steps < 1 or args.ranks < 1:
-        parser.error("--steps and --np must be at least 1")
-    out = args.out or Path("runs") / "settings_study" / args.run_dir.resolve().name / "settings.csv"
-    scratch = args.scratch or out.parent / "variants"
-    only = [n.strip() for n in args.only.split(",")] if args.only else None
-    try:
-        table = run_study(args.run_dir, args.steps, args.ranks, out, scratch, args.restart, only,
-                          args.timeout)
-    except DrumflowError as exc:
-        sys.stderr.write(f"error: {exc}\n")
-        return 2 if isinstance(exc, ValueError) else 1
-    cols = ["variant", "status", "coupled_wall_s", "particle_steps_per_s", "speedup_vs_baseline",
-            "pair_pct", "neigh_pct", "walls_pct", "conduction_pct", "neighbor_builds_per_1000_steps",
-            "dangerous_builds", "physics_ok"]
-    with pd.option_context("display.width", 200, "display.max_columns", 20):
-        print(table.reindex(columns=cols).to_string(index=False))
-    print(f"written: {out}, {out.with_suffix('.json')}")
-    return 1 if table["status"].astype(str).str.startswith("failed").any() else 0
-
-
-if __name__ == "__main__":
-    raise SystemExit(main())
+        write()
+        if on_variant is not None:
+            on_variant(variant, index, len(variants), row)
+    return SettingsStudy(table=write(), csv=csv_path, json=json_path, resumed=resumed)
