@@ -20,6 +20,7 @@ from typing import Annotated, Any, Optional
 
 import typer
 from rich.console import Console
+from rich.markup import escape
 from rich.progress import BarColumn, Progress, TaskID, TextColumn, TimeElapsedColumn, TimeRemainingColumn
 from rich.table import Table
 
@@ -166,7 +167,8 @@ def paper(
                 err_console.print(f"model {m}: post-processed {path} (its dumps were newer)",
                                   highlight=False)
         except DrumflowError as exc:  # e.g. a dump still being written by a live run
-            err_console.print(f"[yellow]note:[/] model {m}: not post-processed: {exc}", highlight=False)
+            err_console.print(f"[yellow]note:[/] model {m}: not post-processed: {escape(str(exc))}",
+                              highlight=False)
         runs.append(collect_paper_run(path, m, render_3d=render_3d))
     source = f"--from {root}" if from_ is not None else f"runs in {root}"
     paths = write_paper(runs, out, html, source=source)

@@ -16,6 +16,7 @@ from typing import Annotated, Any, Optional
 import typer
 from rich.console import Console
 from rich.live import Live
+from rich.markup import escape
 from rich.table import Table
 
 from drumflow.errors import DrumflowError, exit_code
@@ -28,7 +29,7 @@ _STYLE = {"done": "green", "running": "cyan", "pending": "white", "failed": "bol
 
 
 def _fail(exc: BaseException) -> None:
-    err_console.print(f"[bold red]error:[/] {exc}", highlight=False)
+    err_console.print(f"[bold red]error:[/] {escape(str(exc))}", highlight=False)
     raise typer.Exit(exit_code(exc))
 
 
