@@ -673,7 +673,12 @@ def ladder(
 ) -> None:
     """Time-to-answer ladder: wall time and errors of several runs of a scene against one
     reference run (runs are replayed, not rerun)."""
-    from drumflow.bench.time_to_answer import SHORT_NAMES, answer_ladder, load_ladder_spec, write_ladder
+    from drumflow.bench.time_to_answer import (
+        LADDER_QUANTITIES,
+        answer_ladder,
+        load_ladder_spec,
+        write_ladder,
+    )
 
     result = answer_ladder(load_ladder_spec(spec))
     paths = write_ladder(result, out or spec.parent)
@@ -686,7 +691,7 @@ def ladder(
                   f"answer known within ±{result.spec.tolerance:.0%})", box=box.SIMPLE,
                   padding=(0, 1))
     for title in ("rung", "stop", "at s", "wall h", "faster",
-                  *(f"Δ {SHORT_NAMES[q]}" for q in answers), "known"):
+                  *(f"Δ {LADDER_QUANTITIES[q].short}" for q in answers), "known"):
         table.add_column(title, justify="left" if title in ("rung", "stop") else "right")
     for _, row in result.table.iterrows():
         wall = row["wall_s"]

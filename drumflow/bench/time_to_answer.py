@@ -35,7 +35,7 @@ import math
 import tomllib
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Literal
+from typing import TYPE_CHECKING, Any, Literal, NamedTuple
 
 import numpy as np
 import pandas as pd
@@ -52,19 +52,25 @@ if TYPE_CHECKING:
 Answer = Literal["temperature", "mass_flow", "steady_mass_flow", "h"]
 StopMode = Literal["fixed", "settled", "rule"]
 
-#: Every quantity the ladder reports: its column in the replay table and its label.
-LADDER_QUANTITIES: dict[str, tuple[str, str]] = {
-    "temperature": ("temperature_C", "mean temperature at 3.5 s"),
-    "mass_flow": ("mass_flow_kg_s", "falling mass flow, paper's window"),
-    "steady_mass_flow": ("steady_mass_flow_kg_s", "falling mass flow, cascading bed (MSER)"),
-    "h": ("h_W_m2K", "h, Eq. 39"),
+class LadderQuantity(NamedTuple):
+    """One quantity the ladder reports, and where the answer replay keeps it."""
+
+    column: str  #: its column in the replay table
+    half_width: str  #: the reference's batch-means half-width column (the noise floor)
+    short: str  #: for tables
+    label: str  #: for people
+
+
+#: Every quantity the ladder reports.
+LADDER_QUANTITIES: dict[str, LadderQuantity] = {
+    "temperature": LadderQuantity("temperature_C", "temperature_half_width_K", "T(3.5)",
+                                  "mean temperature at 3.5 s"),
+    "mass_flow": LadderQuantity("mass_flow_kg_s", "mass_flow_half_width_kg_s", "ṁ paper",
+                                "falling mass flow, paper's window"),
+    "steady_mass_flow": LadderQuantity("steady_mass_flow_kg_s", "steady_mass_flow_half_width_kg_s",
+                                       "ṁ steady", "falling mass flow, cascading bed (MSER)"),
+    "h": LadderQuantity("h_W_m2K", "h_half_width_W_m2K", "h", "h, Eq. 39"),
 }
-#: Short names for tables.
-SHORT_NAMES = {"temperature": "T(3.5)", "mass_flow": "ṁ paper", "steady_mass_flow": "ṁ steady",
-               "h": "h"}
-#: The reference's half-width column of each quantity (batch means; the noise floor).
-_HALF_WIDTH = {"temperature": "temperature_half_width_K", "mass_flow": "mass_flow_half_width_kg_s",
-               "steady_mass_flow": "steady_mass_flow_half_width_kg_s", "h": "h_half_width_W_m2K"}
 _TIME_EPS_S = 1e-6
 LADDER_FILES = ("ladder.csv", "ladder.json", "ladder.png")
 
@@ -213,7 +219,7 @@ def _stop(rung: RungSpec, replay: AnswerReplay, spec: LadderSpec,
     """When the rung stops, what it reports then, and a note."""
     times = replay.table["time_s"].to_numpy(float)
     end = float(times[-1])
-    columns = {q: col for q, (col, _) in LADDER_QUANTITIES.items()}
+    columns = {q: quantity.column for q, quantity in LADDER_QUANTITIES.items()}
     if rung.stop == "rule" and replay.first_fire_s is not None:
         t = replay.first_fire_s
         values = {q: float(replay.at_first_fire.get(col, math.nan)) for q, col in columns.items()}
@@ -257,9 +263,9 @@ def answer_ladder(spec: LadderSpec) -> AnswerLadder:
     ref_rung = next(r for r in spec.rungs if r.name == spec.reference)
     ref = replay_of(ref_rung)
     last = ref.reference
-    reference_values = {q: float(last[col]) for q, (col, _) in LADDER_QUANTITIES.items()}
-    noise_floor = {q: abs(float(last[_HALF_WIDTH[q]]) / reference_values[q])
-                   for q in LADDER_QUANTITIES}
+    reference_values = {q: float(last[quantity.column]) for q, quantity in LADDER_QUANTITIES.items()}
+    noise_floor = {q: abs(float(last[quantity.half_width]) / reference_values[q])
+                   for q, quantity in LADDER_QUANTITIES.items()}
     ref_wall = ref.wall_at(float(last["time_s"]))
     reference_wall = None if ref_wall is None else ref_wall * ref_rung.wall_scale
 
