@@ -60,7 +60,10 @@ class DeckFiles:
     cross_pattern: str = "dumps/cross.*.txt"
     snapshot_pattern: str = "dumps/snap.*.txt"
     restart_pattern: str = "restart/drum.*.restart"
-    final_restart: str = "restart/final.restart"
+    #: The state at the end, numbered like the others (LIGGGHTS puts the step for the "*"), so
+    #: that it is the newest restart: what a settings study or a longer run starts from. A
+    #: separate final.restart was a third copy of the same state at the end of a run.
+    final_restart: str = "restart/drum.*.restart"
 
 
 @dataclass(frozen=True)

@@ -185,9 +185,10 @@ def latest_restart(folder: Path) -> tuple[Path, int] | None:
     return (found[-1][1], found[-1][0]) if found else None
 
 
-#: Restart files kept in ``dem/restart``: the newest resumes the run; the one before it is a
-#: spare. Older ones only take disk (170 MB each for paper model two's 299,164 particles, 35 of
-#: them in a 17.5 s run), so they are removed as the run goes.
+#: Restart files kept in ``dem/restart`` while a run goes: the newest resumes the run; the one
+#: before it is a spare (one at the end, :func:`_tidy_output`). Older ones only take disk (170
+#: MB each for paper model two's 299,164 particles, 35 of them in a 17.5 s run), so they are
+#: removed as the run goes.
 KEEP_RESTARTS = 2
 #: How often (wall seconds) the run's thermo rows trigger the pruning.
 PRUNE_EVERY_S = 60.0
@@ -197,7 +198,7 @@ def prune_restarts(folder: Path, keep: int = KEEP_RESTARTS, protect: Path | None
     """Remove all but the ``keep`` newest ``drum.STEP.restart`` files of ``folder``.
 
     Safe while LIGGGHTS runs: a file it is still writing is the newest, and the newest are
-    kept. Other files (``final.restart``) and ``protect`` (the restart this attempt resumed
+    kept. Other files and ``protect`` (the restart this attempt resumed
     from, which its deck names and the resume check reads) are not touched. Returns the removed
     paths.
     """
@@ -210,13 +211,18 @@ def prune_restarts(folder: Path, keep: int = KEEP_RESTARTS, protect: Path | None
 
 
 def _tidy_output(restarts: Path, dumps: Path, resumed_from: Path | None,
-                 keep_newest_snapshot: bool) -> None:
-    """Prune restarts and pack finished snapshots. Housekeeping never stops a run: a file that
-    cannot be packed (a snapshot cut short by an earlier kill) stays text, for ``drumflow post``
-    to name."""
+                 finished: bool) -> None:
+    """Prune restarts and pack snapshots. Housekeeping never stops a run: a file that cannot be
+    packed (a snapshot cut short by an earlier kill) stays text, for ``drumflow post`` to name.
+
+    While the run goes, the newest snapshot (perhaps still being written) stays text and the
+    newest two restarts stay (the newest may be cut short by a kill). Once it has finished, its
+    last restart is complete: that one stays (the end state, to start a study or a longer run
+    from), with the one the attempt resumed from (the resume check re-reads it).
+    """
     try:
-        prune_restarts(restarts, protect=resumed_from)
-        pack_dumps(dumps, "snap", keep_newest=1 if keep_newest_snapshot else 0,
+        prune_restarts(restarts, keep=1 if finished else KEEP_RESTARTS, protect=resumed_from)
+        pack_dumps(dumps, "snap", keep_newest=0 if finished else 1,
                    skip_unreadable=True)
     except OSError:
         pass  # a full disk or a vanished folder: the run itself will say so if it matters
@@ -313,7 +319,7 @@ class _RowWatcher:
         if len(self.parser.rows) == before:
             return
         if time.monotonic() - self._pruned_at > PRUNE_EVERY_S:
-            _tidy_output(self.restarts, self.dumps, self.resumed_from, keep_newest_snapshot=True)
+            _tidy_output(self.restarts, self.dumps, self.resumed_from, finished=False)
             self._pruned_at = time.monotonic()
         row = self.parser.rows[-1]
         diagnosis = self.monitor.check(int(row[0]), row[1], int(row[2]), row[3], row[4], row[6])
@@ -370,7 +376,7 @@ def _launch(case: Case, rundir: RunDir, runner: Runner, inputs: DemInputs, deck_
     finally:
         rundir.record_commands([r.as_dict() for r in runner.records if r.program == "liggghts"][-1:])
     wall = time.perf_counter() - t0
-    _tidy_output(rundir.dem_restart, rundir.dem_dumps, resumed_from, keep_newest_snapshot=False)
+    _tidy_output(rundir.dem_restart, rundir.dem_dumps, resumed_from, finished=True)
     rundir.record("stability", watcher.record(stopped=False))
     return watcher, log, wall
 

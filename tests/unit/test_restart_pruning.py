@@ -1,4 +1,5 @@
-"""Restart files: a long run keeps only the newest two (drumflow.dem.stage.prune_restarts).
+"""Restart files: a long run keeps only the newest two (drumflow.dem.stage.prune_restarts), a
+finished one its end state.
 The solver side (a 20-restart run left with two, and resumed) is in
 tests/solver/test_liggghts_drum.py::test_interrupted_run_resumes."""
 
