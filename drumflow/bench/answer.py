@@ -52,8 +52,8 @@ Wall time at ``t``: the sum over the coupling updates before ``t`` of the slowes
 An update without them (an older attempt, a shipped folder without ``dem/``) is estimated from a
 particle-steps-per-second rate: the one given, else the measured updates' own, else the run's
 ``run_record.json`` (LIGGGHTS loop time of the shipped run). So is a logged update slower than
-:data:`PAUSED_FACTOR` times the median (a process stopped from outside for that long). Set-up,
-the air solve and post-processing are not counted.
+:data:`drumflow.coupling.log.PAUSED_FACTOR` times the median (a process stopped from outside
+for that long). Set-up, the air solve and post-processing are not counted.
 """
 
 from __future__ import annotations
@@ -86,7 +86,7 @@ from drumflow.convergence import (
     decide,
     mser_truncation,
 )
-from drumflow.coupling.log import WALL_COLUMNS, read_coupling
+from drumflow.coupling.log import read_coupling, update_walls
 from drumflow.coupling.stop import StopMonitor, min_stop_time, rule_inputs
 from drumflow.errors import (
     AnalysisInputError,
@@ -120,11 +120,6 @@ TEMPERATURE_TIME_S = 3.5
 #: second the falling mass flow has seen about one lifter's discharge (paper model two: 12
 #: lifters at 5 rpm, one per second).
 MIN_WINDOW_S = 1.0
-#: A logged coupling update slower than this many times the run's median update was paused
-#: from outside (a stopped process), not computed: its wall time is estimated from the rate.
-#: Real updates of one run differ by less than 2 times (paper model two: median 9.1 s, slowest
-#: 13.3 s over 3.5-5.2 s); the pauses seen were hours long.
-PAUSED_FACTOR = 20.0
 #: The answer's three quantities: column of the value, and its label.
 QUANTITIES = {"temperature": ("temperature_C", "(a) mean temperature at 3.5 s"),
               "mass_flow": ("mass_flow_kg_s", "(b) falling mass flow"),
@@ -675,19 +670,15 @@ def _wall_per_update(run: RunDir, updates: pd.DataFrame, dt: float,
     paused_updates = 0
     folder = run.dem_coupling_logs
     if folder.is_dir() and any(folder.glob("rank*.csv")):
-        logs = read_coupling(folder, dt)
-        if set(WALL_COLUMNS) <= set(logs.columns):
-            logs = logs.assign(wall_s=logs["python_wall_s"] + logs["liggghts_wall_s"])
+        logs = update_walls(read_coupling(folder, dt))
+        if not logs.empty:
             # The logs may reach past the post-processed series (a run still going): every
             # logged update gives the rate, those in the series their own wall time.
-            logged = logs[np.isfinite(logs["wall_s"])]
             # A process stopped from outside (SIGSTOP, a suspended laptop, a pre-empted node)
             # logs the pause in the update it interrupted: hours against seconds. Such an
             # update is not the code's speed; it is estimated from the rate like an unlogged one.
-            median = float(logged["wall_s"].median()) if not logged.empty else math.nan
-            paused = logged["wall_s"] > PAUSED_FACTOR * median
-            paused_updates = int(paused.sum())
-            logged = logged[~paused]
+            paused_updates = int(logs["paused"].sum())
+            logged = logs[~logs["paused"].astype(bool)]
             per_step = dict(zip(logged["step"].to_numpy(int), logged["wall_s"].to_numpy(float),
                                 strict=True))
             measured = np.array([per_step.get(int(s), math.nan) for s in updates["step"]])

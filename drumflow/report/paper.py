@@ -132,6 +132,18 @@ def _loop_time_s(run: RunDir) -> float | None:
     return sum(found) if found else None
 
 
+def _coupled_wall(run: RunDir, dt: float | None) -> dict[str, Any] | None:
+    from drumflow.coupling.log import coupled_wall_s, read_coupling
+
+    if dt is None or not run.dem_coupling_logs.is_dir():
+        return None
+    return coupled_wall_s(read_coupling(run.dem_coupling_logs, dt))
+
+
+def _resumed(run: RunDir) -> bool:
+    return any(True for _ in run.dem.glob("log.resume-*.liggghts"))
+
+
 def _dump_span_s(run: RunDir) -> tuple[float, float] | None:
     """(first, last) modification time of the dump files: when the DEM wrote its output."""
     if not run.dem_dumps.is_dir():
@@ -178,8 +190,19 @@ def run_record(root: Path | str) -> dict[str, Any]:
         if files:
             simulated = int(files[-1].name.split(".")[1]) * dt
             source = "newest dump file"
-    dem_wall = summary.get("dem_wall_time_s")
-    dem_source = "summary.json (the last `drumflow run` call)"
+    # A long run is made of attempts (resumed after interrupts, sometimes paused): the coupling
+    # logs time every update of every attempt; summary.json has only the last call.
+    dem_wall, dem_source = None, ""
+    coupled = _coupled_wall(run, dt)
+    if coupled is not None:
+        dem_wall = coupled["wall_s"]
+        dem_source = "coupling updates, every attempt"
+        if coupled["estimated_s"] > 0:
+            dem_source += (f" ({coupled['paused_updates']} paused and {coupled['unlogged_updates']} "
+                           f"unlogged updates at the others' rate: {coupled['estimated_s']:.0f} s)")
+    if dem_wall is None and summary.get("dem_wall_time_s") is not None and not _resumed(run):
+        dem_wall = summary["dem_wall_time_s"]
+        dem_source = "summary.json (the run's one `drumflow run` call)"
     if dem_wall is None:
         dem_wall, dem_source = _loop_time_s(run), "LIGGGHTS loop time, every attempt"
     if dem_wall is None:

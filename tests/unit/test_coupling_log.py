@@ -75,3 +75,26 @@ def test_heat_counts_only_up_to_the_last_temperature_output() -> None:
     assert heat_removed_until(log, 0.02, dt) == pytest.approx(100 * 0.01 + 200 * 0.01)
     # Half-way through the second update.
     assert heat_removed_until(log, 0.015, dt) == pytest.approx(100 * 0.01 + 200 * 0.005)
+
+
+def test_coupled_wall_counts_every_attempt_and_estimates_pauses(tmp_path: Path) -> None:
+    from drumflow.coupling.log import PAUSED_FACTOR, coupled_wall_s
+
+    # An old attempt without wall times (2 updates), then a resumed one: 8 updates of 2 s, one of
+    # them stopped from outside for an hour. Every update moves the same particle-steps, so the
+    # three not measured (2 unlogged, 1 paused) count 2 s each: 7 x 2 + 3 x 2 = 20 s.
+    (tmp_path / "rank0.0.csv").write_text(OLD_HEADER + _row(0, -1.0, 5) + "\n" + _row(100, -1.0, 5) + "\n")
+    walls = [2.0] * 8
+    walls[3] = 3600.0
+    rows = [f"{_row(200 + 100 * k, -1.0, 5)},{w - 0.5},0.5" for k, w in enumerate(walls)]
+    (tmp_path / "rank0.200.csv").write_text(NEW_HEADER + "\n".join(rows) + "\n")
+    assert 3600.0 > PAUSED_FACTOR * 2.0
+    wall = coupled_wall_s(read_coupling(tmp_path, DT))
+    assert wall is not None
+    assert wall["wall_s"] == pytest.approx(20.0)
+    assert wall["measured_s"] == pytest.approx(14.0) and wall["estimated_s"] == pytest.approx(6.0)
+    assert wall["paused_updates"] == 1 and wall["unlogged_updates"] == 2
+    assert wall["particle_steps_per_s"] == pytest.approx(5 * 100 / 2.0)
+    # Old logs alone: nothing measured, so no wall time (not a guess).
+    (tmp_path / "rank0.200.csv").unlink()
+    assert coupled_wall_s(read_coupling(tmp_path, DT)) is None

@@ -321,6 +321,34 @@ def test_dem_wall_time_of_a_resumed_run_is_its_loop_time_not_a_file_time_span(
     assert "loop time" in record["dem_wall_time_source"]
 
 
+def test_dem_wall_time_of_a_resumed_run_counts_every_attempt_not_the_last_call(
+        tmp_path: Path, write_synthetic_run: Callable[..., Any]) -> None:
+    # Regression: a finished run's summary.json has the DEM wall time of its last `drumflow run`
+    # call only (model two's last attempt: about an hour of a 4-hour run).
+    import json as _json
+
+    from drumflow.report.paper import run_record
+
+    root = write_synthetic_run(tmp_path / "run")
+    dt = _json.loads((root / "manifest.json").read_text())["time_step"]["time_step"]
+    summary = _json.loads((root / "summary.json").read_text())
+    summary["dem_wall_time_s"] = 5.0  # the last call
+    (root / "summary.json").write_text(_json.dumps(summary))
+    logs = root / "dem" / "coupling"
+    logs.mkdir(parents=True, exist_ok=True)
+    header = ("step,time_s,steps,heat_to_particles_W,drag_x_N,drag_y_N,drag_z_N,particles,"
+              "python_wall_s,liggghts_wall_s\n")
+    for start, walls in ((0, [3.0, 3.0]), (68, [2.0, 3600.0, 2.0])):
+        rows = [f"{start + 34 * k},{(start + 34 * k) * dt},34,-1,0,0,0,9,0.5,{w - 0.5}"
+                for k, w in enumerate(walls)]
+        (logs / f"rank0.{start}.csv").write_text(header + "\n".join(rows) + "\n")
+    (root / "dem" / "log.resume-68.liggghts").write_text("Loop time of 7 on 2 procs for 34 steps\n")
+    record = run_record(root)
+    # 3 + 3 + 2 + 2 measured, the paused update at the others' rate (2.5 s per update).
+    assert record["dem_wall_time_s"] == pytest.approx(12.5)
+    assert "every attempt" in record["dem_wall_time_source"] and "1 paused" in record["dem_wall_time_source"]
+
+
 def test_page_says_when_a_model_was_coarse_grained(
         tmp_path: Path, write_synthetic_run: Callable[..., Any],
         synthetic_case_dict: Callable[..., dict[str, Any]]) -> None:
