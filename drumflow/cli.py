@@ -17,14 +17,6 @@ from typing import Annotated, Any
 import typer
 from rich import box
 from rich.console import Console
-from rich.progress import (
-    BarColumn,
-    Progress,
-    TaskID,
-    TextColumn,
-    TimeElapsedColumn,
-    TimeRemainingColumn,
-)
 from rich.table import Table
 
 from drumflow.cli_cooler import app as cooler_app
@@ -32,6 +24,7 @@ from drumflow.cli_cooler.drum import drum as plant
 from drumflow.cli_export import export
 from drumflow.cli_guard import guard_every_command
 from drumflow.cli_paper import paper
+from drumflow.cli_progress import StageProgress
 from drumflow.cli_sweep import sweep
 
 app = typer.Typer(
@@ -99,28 +92,8 @@ def run(
 
     case = _load(case_file)
     out = out or Path("runs") / case.name
-    columns = (
-        TextColumn("[bold]{task.description}"),
-        BarColumn(),
-        TextColumn("{task.fields[sim]}"),
-        TimeElapsedColumn(),
-        TextColumn("ETA"),
-        TimeRemainingColumn(),
-    )
     try:
-        with Progress(*columns, console=err_console, transient=False) as bar:
-            tasks: dict[str, TaskID] = {}
-
-            def progress(stage: str, done: float, total: float) -> None:
-                # One bar per stage; a stage may change its total (the air stage ends with
-                # (1, 1) when it converges before air.max_iterations), so the bar finishes.
-                if stage not in tasks:
-                    tasks[stage] = bar.add_task(stage, total=total, sim="")
-                sim = f"{done:.3f}/{total:.3f} s simulated" if stage == "dem" else ""
-                bar.update(tasks[stage], completed=done, total=total, sim=sim)
-                if done >= total:
-                    bar.stop_task(tasks[stage])
-
+        with StageProgress(err_console) as progress:
             summary = run_case(case, out, processes=np_, steps=steps, timeout=timeout,
                                progress=progress, force=force)
     except KeyboardInterrupt:

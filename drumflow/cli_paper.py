@@ -21,9 +21,9 @@ from typing import Annotated, Any, Optional
 import typer
 from rich.console import Console
 from rich.markup import escape
-from rich.progress import BarColumn, Progress, TaskID, TextColumn, TimeElapsedColumn, TimeRemainingColumn
 from rich.table import Table
 
+from drumflow.cli_progress import StageProgress
 from drumflow.errors import CaseError, DrumflowError
 
 console = Console()
@@ -72,22 +72,10 @@ def _run_model(case_file: Path, out: Path, processes: int | None) -> None:
     if _finished(out, case.hash()):
         err_console.print(f"{case.name}: finished run reused ({out})", highlight=False)
         return
-    columns = (TextColumn("[bold]{task.description}"), BarColumn(), TextColumn("{task.fields[sim]}"),
-               TimeElapsedColumn(), TextColumn("ETA"), TimeRemainingColumn())
     err_console.print(f"{case.name}: running into {out} (rerun the same command to resume)",
                       highlight=False)
     try:
-        with Progress(*columns, console=err_console, transient=False) as bar:
-            tasks: dict[str, TaskID] = {}
-
-            def progress(stage: str, done: float, total: float) -> None:
-                if stage not in tasks:
-                    tasks[stage] = bar.add_task(f"{case.name} {stage}", total=total, sim="")
-                sim = f"{done:.3f}/{total:.3f} s simulated" if stage == "dem" else ""
-                bar.update(tasks[stage], completed=done, total=total, sim=sim)
-                if done >= total:
-                    bar.stop_task(tasks[stage])
-
+        with StageProgress(err_console, prefix=f"{case.name} ") as progress:
             summary = run_case(case, out, processes=processes, progress=progress)
     except KeyboardInterrupt:
         err_console.print(f"run the same command again to resume into {out}")
