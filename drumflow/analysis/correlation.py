@@ -419,6 +419,71 @@ def _residual_spread(y: NDArray[np.float64], x: NDArray[np.float64] | None) -> f
     return float(np.std(y - design @ coef))
 
 
+def _prandtl_choice(ln_pr: NDArray[np.float64], ln_re: NDArray[np.float64],
+                    fit_prandtl_exponent: bool | None, c_fixed: float, tol: float) -> tuple[bool, str]:
+    """Whether ``c`` is fitted, and the note saying why not (module notes)."""
+    if fit_prandtl_exponent is not None:
+        fit_c = bool(fit_prandtl_exponent)
+        return fit_c, "" if fit_c else f"c held at {c_fixed:.6g} by request"
+    pr_spread = _residual_spread(ln_pr, ln_re)
+    if pr_spread >= tol:
+        return True, ""
+    return False, (f"Pr does not vary independently of Re (residual spread of ln Pr {pr_spread:.3g} "
+                   f"< {tol:g}); c held at {c_fixed:.6g}, a absorbs Pr^c")
+
+
+def _power_law_fit(nu: NDArray[np.float64], ln_re: NDArray[np.float64], ln_pr: NDArray[np.float64],
+                   fit_c: bool, c_fixed: float,
+                   ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """Levenberg-Marquardt on ``Nu = a Re^b Pr^c`` (c held unless ``fit_c``), from the
+    log-linear least-squares start: the parameters, the residuals and the Jacobian there."""
+    n = nu.size
+    ln_nu = np.log(nu)
+    # Starting values: linear least squares on the logarithms.
+    if fit_c:
+        design = np.column_stack([np.ones(n), ln_re, ln_pr])
+        target = ln_nu
+    else:
+        design = np.column_stack([np.ones(n), ln_re])
+        target = ln_nu - c_fixed * ln_pr
+    start, *_ = np.linalg.lstsq(design, target, rcond=None)
+    x0 = np.array([math.exp(start[0]), *start[1:]])
+
+    def model(x: NDArray[np.float64]) -> NDArray[np.float64]:
+        c = x[2] if fit_c else c_fixed
+        return x[0] * np.exp(x[1] * ln_re + c * ln_pr)
+
+    def residuals(x: NDArray[np.float64]) -> NDArray[np.float64]:
+        return model(x) - nu
+
+    def jacobian(x: NDArray[np.float64]) -> NDArray[np.float64]:
+        base = model(x) / x[0]  # Re^b Pr^c
+        cols = [base, x[0] * base * ln_re]
+        if fit_c:
+            cols.append(x[0] * base * ln_pr)
+        return np.column_stack(cols)
+
+    # x_scale="jac" keeps a (order 0.01-1) and the exponents (order 0.1-1) equally well
+    # conditioned; tolerances near machine precision so the fit is limited by the data only.
+    sol = least_squares(
+        residuals,
+        x0,
+        jac=jacobian,
+        method="lm",
+        x_scale="jac",
+        ftol=1e-14,
+        xtol=1e-14,
+        gtol=1e-14,
+        max_nfev=10000,
+    )
+    if not sol.success:
+        raise AnalysisInputError(
+            "nusselt", f"{n} points", f"data a power law can be fitted to ({sol.message})"
+        )
+    x = sol.x
+    return x, residuals(x), jacobian(x)
+
+
 def fit_nusselt_correlation(
     nusselt: ArrayLike,
     reynolds: ArrayLike,
@@ -484,7 +549,7 @@ def fit_nusselt_correlation(
                                      f"one per point ({keep.size})")
         labels = all_labels[keep]
 
-    ln_nu, ln_re, ln_pr = np.log(nu), np.log(re), np.log(pr)
+    ln_re, ln_pr = np.log(re), np.log(pr)
     n = int(nu.size)
     if n < 3:
         raise AnalysisInputError("nusselt", f"{n} usable point(s)", "at least 3 points")
@@ -496,72 +561,17 @@ def fit_nusselt_correlation(
             "(combine runs with different particle diameters or air velocities)",
         )
 
-    pr_spread = _residual_spread(ln_pr, ln_re)
-    note = ""
-    if fit_prandtl_exponent is None:
-        fit_c = pr_spread >= tol
-        if not fit_c:
-            note = (
-                f"Pr does not vary independently of Re (residual spread of ln Pr {pr_spread:.3g} "
-                f"< {tol:g}); c held at {c_fixed:.6g}, a absorbs Pr^c"
-            )
-    else:
-        fit_c = bool(fit_prandtl_exponent)
-        if not fit_c:
-            note = f"c held at {c_fixed:.6g} by request"
+    fit_c, note = _prandtl_choice(ln_pr, ln_re, fit_prandtl_exponent, c_fixed, tol)
     n_params = 3 if fit_c else 2
     if n <= n_params:
         raise AnalysisInputError(
             "nusselt", f"{n} usable point(s)", f"more points than parameters (> {n_params})"
         )
 
-    # Starting values: linear least squares on the logarithms.
-    if fit_c:
-        design = np.column_stack([np.ones(n), ln_re, ln_pr])
-        target = ln_nu
-    else:
-        design = np.column_stack([np.ones(n), ln_re])
-        target = ln_nu - c_fixed * ln_pr
-    start, *_ = np.linalg.lstsq(design, target, rcond=None)
-    x0 = np.array([math.exp(start[0]), *start[1:]])
-
-    def model(x: NDArray[np.float64]) -> NDArray[np.float64]:
-        c = x[2] if fit_c else c_fixed
-        return x[0] * np.exp(x[1] * ln_re + c * ln_pr)
-
-    def residuals(x: NDArray[np.float64]) -> NDArray[np.float64]:
-        return model(x) - nu
-
-    def jacobian(x: NDArray[np.float64]) -> NDArray[np.float64]:
-        base = model(x) / x[0]  # Re^b Pr^c
-        cols = [base, x[0] * base * ln_re]
-        if fit_c:
-            cols.append(x[0] * base * ln_pr)
-        return np.column_stack(cols)
-
-    # x_scale="jac" keeps a (order 0.01-1) and the exponents (order 0.1-1) equally well
-    # conditioned; tolerances near machine precision so the fit is limited by the data only.
-    sol = least_squares(
-        residuals,
-        x0,
-        jac=jacobian,
-        method="lm",
-        x_scale="jac",
-        ftol=1e-14,
-        xtol=1e-14,
-        gtol=1e-14,
-        max_nfev=10000,
-    )
-    if not sol.success:
-        raise AnalysisInputError(
-            "nusselt", f"{n} points", f"data a power law can be fitted to ({sol.message})"
-        )
-    x = sol.x
-    res = residuals(x)
+    x, res, jac = _power_law_fit(nu, ln_re, ln_pr, fit_c, c_fixed)
     sse = float(res @ res)
     dof = n - n_params
     s2 = sse / dof
-    jac = jacobian(x)
     # Covariance from the Gauss-Newton approximation; pinv guards a nearly singular J^T J.
     cov = s2 * np.linalg.pinv(jac.T @ jac)
     se = np.sqrt(np.clip(np.diag(cov), 0.0, None))
