@@ -318,6 +318,70 @@ def _cell_matrix(model: SphereConduction, h_fall: float, h_bed: float, fall_time
     return mat
 
 
+@dataclass(frozen=True)
+class _CellMarch:
+    """One pass of the solids through the cells, inlet to outlet, against counter-current air.
+
+    Each cell's exchange is affine in the air temperature it sees (its matrices, built for the
+    air properties of the last pass), so a pass from a guessed air outlet temperature is exact
+    for that guess: :func:`solve_drum` finds the outlet from two passes.
+    """
+
+    plant: PlantSpec
+    opt: DrumOptions
+    model: SphereConduction
+    sphere: Sphere
+    rate: float  #: particles per second
+    c_air: float  #: air heat-capacity rate, W/K
+    wall_area: float  #: shell area of one cell, m2
+
+    def march(self, mats: list[FloatArray], unit: list[FloatArray],
+              t_air_out: float) -> tuple[FloatArray, ...]:
+        """Solids and air temperatures at the cell faces, each cell's curtain, bed and wall
+        heat (W), the air temperature each cell saw, and the solids' state at the outlet."""
+        plant, opt, model, sphere = self.plant, self.opt, self.model, self.sphere
+        rate, c_air, wall_area = self.rate, self.c_air, self.wall_area
+        n = model.shells
+        cells = len(mats)
+        state = model.uniform(plant.material_inlet_temperature_c)
+        t_out = t_air_out
+        solids = [model.mean_temperature(state)]
+        air_faces = [t_out]
+        q_f = np.empty(cells)
+        q_b = np.empty(cells)
+        q_w = np.empty(cells)
+        seen = np.empty(cells)
+        for i in range(cells):
+            base = mats[i] @ np.concatenate([state, [0.0, 0.0, 0.0]])
+            a_f, a_b = rate * base[n + 1], rate * base[n + 2]
+            b_f, b_b = rate * unit[i][n + 1], rate * unit[i][n + 2]
+            b = b_f + b_b
+            denominator = 1.0 + 0.5 * b / c_air
+            if denominator <= 0.1:
+                raise DrumModelError(
+                    f"cells = {cells}: a cell exchanges more than the air can carry at "
+                    f"{plant.air_mass_flow_kg_s:g} kg/s; use more cells"
+                )
+            heat = (a_f + a_b + b * t_out) / denominator
+            t_mean = t_out - 0.5 * heat / c_air
+            seen[i] = t_mean
+            new = base[:n] + unit[i][:n] * t_mean
+            q_f[i] = a_f + b_f * t_mean
+            q_b[i] = a_b + b_b * t_mean
+            t_in_air = t_out - (q_f[i] + q_b[i]) / c_air
+            if opt.wall_loss_w_m2k > 0:
+                t_solid = 0.5 * (model.mean_temperature(state) + model.mean_temperature(new))
+                q_w[i] = opt.wall_loss_w_m2k * wall_area * (t_solid - opt.ambient_temperature_c)
+                new = new - q_w[i] / (rate * sphere.mass * sphere.heat_capacity)
+            else:
+                q_w[i] = 0.0
+            state = new
+            t_out = t_in_air
+            solids.append(model.mean_temperature(state))
+            air_faces.append(t_out)
+        return (np.array(solids), np.array(air_faces), q_f, q_b, q_w, seen, state)
+
+
 def solve_drum(plant: PlantSpec, closures: SliceClosures, law: TransportLaw,
                options: DrumOptions | None = None) -> DrumResult:
     """Predict the plant's outlets from slice closures (module notes).
@@ -363,53 +427,13 @@ def solve_drum(plant: PlantSpec, closures: SliceClosures, law: TransportLaw,
     bed_share = scaled.bed_surface_m2_per_m / (bed_particles_per_m * sphere.surface)
     if not opt.bed_exchange:
         bed_share = 0.0
-    wall_area = math.pi * plant.diameter_m * dz
+    marcher = _CellMarch(plant, opt, model, sphere, rate, c_air, math.pi * plant.diameter_m * dz)
 
     def film(t_air: float) -> tuple[float, float]:
         air = AirState.at(t_air, _PRESSURE_KPA)
         h_fall = float(ranz_marshall_h(scaled.fall_effective_slip_m_s, sphere.diameter, air))
         h_surface = float(ranz_marshall_h(scaled.axial_air_velocity_m_s, sphere.diameter, air))
         return h_fall, h_surface
-
-    def march(mats: list[FloatArray], unit: list[FloatArray],
-              t_air_out: float) -> tuple[FloatArray, ...]:
-        state = model.uniform(plant.material_inlet_temperature_c)
-        t_out = t_air_out
-        solids = [model.mean_temperature(state)]
-        air_faces = [t_out]
-        q_f = np.empty(cells)
-        q_b = np.empty(cells)
-        q_w = np.empty(cells)
-        seen = np.empty(cells)
-        for i in range(cells):
-            base = mats[i] @ np.concatenate([state, [0.0, 0.0, 0.0]])
-            a_f, a_b = rate * base[n + 1], rate * base[n + 2]
-            b_f, b_b = rate * unit[i][n + 1], rate * unit[i][n + 2]
-            b = b_f + b_b
-            denominator = 1.0 + 0.5 * b / c_air
-            if denominator <= 0.1:
-                raise DrumModelError(
-                    f"cells = {cells}: a cell exchanges more than the air can carry at "
-                    f"{plant.air_mass_flow_kg_s:g} kg/s; use more cells"
-                )
-            heat = (a_f + a_b + b * t_out) / denominator
-            t_mean = t_out - 0.5 * heat / c_air
-            seen[i] = t_mean
-            new = base[:n] + unit[i][:n] * t_mean
-            q_f[i] = a_f + b_f * t_mean
-            q_b[i] = a_b + b_b * t_mean
-            t_in_air = t_out - (q_f[i] + q_b[i]) / c_air
-            if opt.wall_loss_w_m2k > 0:
-                t_solid = 0.5 * (model.mean_temperature(state) + model.mean_temperature(new))
-                q_w[i] = opt.wall_loss_w_m2k * wall_area * (t_solid - opt.ambient_temperature_c)
-                new = new - q_w[i] / (rate * sphere.mass * sphere.heat_capacity)
-            else:
-                q_w[i] = 0.0
-            state = new
-            t_out = t_in_air
-            solids.append(model.mean_temperature(state))
-            air_faces.append(t_out)
-        return (np.array(solids), np.array(air_faces), q_f, q_b, q_w, seen, state)
 
     # First guess of the air profile: a linear profile with the air taking 70 % of the heat
     # the solids could give (only sets the first air properties).
@@ -432,10 +456,10 @@ def solve_drum(plant: PlantSpec, closures: SliceClosures, law: TransportLaw,
             units.append(mat @ unit_state)
         # The march is affine in the air outlet temperature: two marches find it exactly.
         lo, hi = plant.air_inlet_temperature_c, plant.material_inlet_temperature_c
-        r_lo = march(mats, units, lo)[1][-1] - plant.air_inlet_temperature_c
-        r_hi = march(mats, units, hi)[1][-1] - plant.air_inlet_temperature_c
+        r_lo = marcher.march(mats, units, lo)[1][-1] - plant.air_inlet_temperature_c
+        r_hi = marcher.march(mats, units, hi)[1][-1] - plant.air_inlet_temperature_c
         t_ao = lo - r_lo * (hi - lo) / (r_hi - r_lo)
-        solids, air_faces, q_f, q_b, q_w, new_seen, final = march(mats, units, t_ao)
+        solids, air_faces, q_f, q_b, q_w, new_seen, final = marcher.march(mats, units, t_ao)
         change = float(np.max(np.abs(new_seen - seen)))
         seen = new_seen
         if change < 1e-6:
