@@ -214,6 +214,18 @@ def _relative(values: Any, reference: float) -> NDArray[np.float64]:
     return np.asarray(values, dtype=float) / reference - 1.0
 
 
+def estimated_share(table: pd.DataFrame, t: float) -> float:
+    """Share of the wall time up to ``t`` that was estimated (not logged), from the replay
+    table's grid: the last grid time at or before ``t`` (the first, before the grid starts).
+
+    The converged rule fires between grid times: looking for ``t`` itself on the grid found
+    nothing there, and called such a rung's wall time measured.
+    """
+    upto = table[table["time_s"] <= t + _TIME_EPS_S]
+    return float(upto["wall_estimated_share"].iloc[-1] if not upto.empty
+                 else table["wall_estimated_share"].iloc[0])
+
+
 def _stop(rung: RungSpec, replay: AnswerReplay, spec: LadderSpec,
           reference_values: dict[str, float]) -> tuple[float | None, dict[str, float], str]:
     """When the rung stops, what it reports then, and a note."""
@@ -275,11 +287,7 @@ def answer_ladder(spec: LadderSpec) -> AnswerLadder:
         t, values, note = _stop(rung, replay, spec, reference_values)
         wall = replay.wall_at(t) if t is not None else None
         wall_s = math.nan if wall is None else wall * rung.wall_scale
-        share = 0.0
-        if t is not None:
-            at = replay.table[np.abs(replay.table["time_s"] - t) < _TIME_EPS_S]
-            if not at.empty:
-                share = float(at["wall_estimated_share"].iloc[0])
+        share = 0.0 if t is None else estimated_share(replay.table, t)
         row: dict[str, Any] = {
             "rung": rung.name, "description": rung.description, "stop": rung.stop,
             "stop_time_s": math.nan if t is None else t, "run_end_s": replay.reference_time_s,

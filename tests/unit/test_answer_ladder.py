@@ -106,6 +106,7 @@ def test_rungs_stop_where_their_rules_say_with_walls_and_errors(folder: Path) ->
     assert rows.loc["rule", "value_steady_mass_flow"] == pytest.approx(
         own.at_first_fire["steady_mass_flow_kg_s"])
     assert np.isfinite(rows.loc["rule", "value_steady_mass_flow"])
+    assert rows.loc["rule", "wall_estimated"] and rows.loc["settled", "wall_estimated"]
     # 5 % more h: never within 1 % of the reference; errors shown at the end.
     assert np.isnan(rows.loc["biased", "stop_time_s"]) and not rows.loc["biased", "within_tolerance"]
     assert rows.loc["biased", "error_h"] == pytest.approx(0.05, abs=2e-3)
@@ -157,3 +158,16 @@ def test_ladder_of_one_rung_writes_a_plot(folder: Path, tmp_path: Path) -> None:
                     f'run = "{folder / "a"}"\n')
     paths = write_ladder(answer_ladder(load_ladder_spec(spec)), tmp_path / "out")
     assert paths["png"].stat().st_size > 0
+
+
+def test_estimated_share_between_grid_times() -> None:
+    # Regression: model two's rule fired at 15.008 s, between grid times; the share was looked
+    # up at 15.008 exactly, found nowhere, and its partly estimated wall was called measured.
+    import pandas as pd
+
+    from drumflow.bench.time_to_answer import estimated_share
+
+    table = pd.DataFrame({"time_s": [1.0, 1.1, 1.2], "wall_estimated_share": [1.0, 0.5, 0.4]})
+    assert estimated_share(table, 1.15) == 0.5
+    assert estimated_share(table, 1.2) == 0.4
+    assert estimated_share(table, 0.5) == 1.0
