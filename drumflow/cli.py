@@ -434,26 +434,33 @@ def bench(
     except KeyboardInterrupt:
         err_console.print(f"run the same command again to resume into {out}")
         raise
-    table = Table(title=f"drumflow bench {case.name} → {out}")
     cols = [("rung", "rung", "{}"), ("dt/t_R", "fraction_of_rayleigh", "{:.2f}"),
             ("DEM s", "dem_wall_time_s", "{:.1f}"), ("speed-up", "speedup_vs_conservative", "{:.2f}"),
             ("err T", "err_temperature", "{:.2%}"), ("err h", "err_h", "{:.2%}"),
             ("err ṁ", "err_mass_flow", "{:.2%}"), ("front", "pareto", "{}")]
-    for title, _, _ in cols:
-        table.add_column(title)
-    for _, r in result.table.iterrows():
-        cells = []
-        for _, key, fmt in cols:
-            v = r.get(key)
-            cells.append("" if v is None or (isinstance(v, float) and v != v) else fmt.format(v))
-        table.add_row(*cells)
-    console.print(table)
+    console.print(_frame_table(f"drumflow bench {case.name} → {out}", result.table, cols))
     console.print(f"written: {result.csv}, {result.json}, {result.plot}", highlight=False)
     failed = [str(r["rung"]) for _, r in result.table.iterrows() if str(r["status"]).startswith("failed")]
     if failed:
         # A rung whose run failed is a failed run (exit 1), even though the table was written.
         err_console.print(f"[bold red]failed rung(s):[/] {', '.join(failed)}", highlight=False)
         raise typer.Exit(1)
+
+
+def _frame_table(title: str, frame: Any, cols: list[tuple[str, str, str]], clip: int | None = None,
+                 box_style: box.Box = box.HEAVY_HEAD) -> Table:
+    """A table of a results frame: one column per (title, key, format); a missing or NaN value
+    is blank; each cell cut to ``clip`` characters (a long status)."""
+    table = Table(title=title, box=box_style)
+    for column, _, _ in cols:
+        table.add_column(column)
+    for _, r in frame.iterrows():
+        cells = []
+        for _, key, fmt in cols:
+            v = r.get(key)
+            cells.append("" if v is None or (isinstance(v, float) and v != v) else fmt.format(v)[:clip])
+        table.add_row(*cells)
+    return table
 
 
 def _bench_from_run(case: Any, run_dir: Path, out: Path | None, rungs: str | None, steps: int,
@@ -484,21 +491,13 @@ def _bench_from_run(case: Any, run_dir: Path, out: Path | None, rungs: str | Non
 
     result = run_settings_study(case, run_dir, out, steps=steps, ranks=ranks, restart_step=restart,
                                 only=names, timeout=timeout or 3600.0, on_variant=on_variant)
-    table = Table(title=f"drumflow bench {case.name} --from {run_dir} → {out}", box=box.SIMPLE)
     cols = [("variant", "variant", "{}"), ("status", "status", "{}"),
             ("wall s", "coupled_wall_s", "{:.1f}"), ("particle-steps/s", "particle_steps_per_s", "{:,.0f}"),
             ("speed-up", "speedup_vs_baseline", "{:.2f}"), ("pair %", "pair_pct", "{:.0f}"),
             ("neigh %", "neigh_pct", "{:.0f}"), ("walls %", "walls_pct", "{:.0f}"),
             ("physics", "physics_ok", "{}")]
-    for title, _, _ in cols:
-        table.add_column(title)
-    for _, r in result.table.iterrows():
-        cells = []
-        for _, key, fmt in cols:
-            v = r.get(key)
-            cells.append("" if v is None or (isinstance(v, float) and v != v) else fmt.format(v)[:40])
-        table.add_row(*cells)
-    console.print(table)
+    console.print(_frame_table(f"drumflow bench {case.name} --from {run_dir} → {out}", result.table,
+                               cols, clip=40, box_style=box.SIMPLE))
     if result.resumed:
         console.print(f"kept from the interrupted study: {', '.join(result.resumed)}", highlight=False)
     console.print(f"written: {result.csv}, {result.json}", highlight=False)
