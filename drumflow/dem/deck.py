@@ -127,8 +127,10 @@ def gravity_vector(tilt_deg: float) -> tuple[float, float, float]:
 
 #: Particle diameters of section length each rank needs before the domain is split along the
 #: drum axis: below it the ghost layers (one diameter plus the skin on each inner face) become a
-#: large share of a rank's particles and the split across the drum is kept.
-AXIAL_SPLIT_MIN_DIAMETERS = 10.0
+#: large share of a rank's particles and the split across the drum is kept. Measured down to
+#: 6.25 (paper model one at 2 ranks, where the axial split won once the bed cascaded); thinner
+#: slabs are not measured.
+AXIAL_SPLIT_MIN_DIAMETERS = 6.0
 
 
 def processors_grid(case: Case, processes: int) -> str:
@@ -139,9 +141,12 @@ def processors_grid(case: Case, processes: int) -> str:
     paper model two at 3.47 s (299,164 particles, 1 m, 2 ranks, 204 steps from one restart,
     ``drumflow bench --from``): the split along z ran 1.61 times faster than the
     split along x (878k against 546k particle-steps per second; 1 rank: 438k), with
-    communication and waiting down from 27 % to 8 % of the loop. A thin slice (the smoke drum,
-    paper model one at 2 ranks: under :data:`AXIAL_SPLIT_MIN_DIAMETERS` diameters per rank)
-    keeps the split across x, which is not measured against z at those thicknesses.
+    communication and waiting down from 27 % to 8 % of the loop. Paper model one (0.1 m of
+    8 mm particles, 6.25 diameters per rank at 2 ranks): a tie at 0.5 s (1.88 M against
+    1.90 M), 1.30 times faster along z at 1.5 s (2.02 M against 1.56 M), as the bed piled up
+    on the rising side (63 % of the particles on one rank at 1 s). A thinner slice (the smoke
+    drum at 2 ranks: 5 diameters per rank) keeps the split across x, which is not measured
+    against z at those thicknesses.
     """
     n = processes
     if n == 1:
