@@ -90,6 +90,10 @@ class Variant:
     moving_shell
         The shell as a rotating mesh (``move/mesh``) like the lifters, instead of the static
         shell with a surface velocity: the wall treatment of the conservative reference.
+    no_conduction
+        ``run.conduction = false`` as drumflow runs it: no heat fix in the deck (the restart's
+        temperatures go into a plain per-atom ``Temp``), and the coupling loop integrates the
+        temperatures. Changes the physics a user set: the row says what it does to the answer.
     """
 
     name: str
@@ -101,6 +105,7 @@ class Variant:
     min_ranks: int = 1
     time_step_factor: float = 1.0
     moving_shell: bool = False
+    no_conduction: bool = False
 
 
 #: What is compared. The deck's own settings are the baseline: ``neighbor SKIN bin`` (half a
@@ -121,6 +126,8 @@ VARIANTS: list[Variant] = [
     Variant("grid_x", "processor grid across the drum, along x", processors="{np} 1 1", min_ranks=2),
     Variant("grid_y", "processor grid across the drum, along y (gravity)", processors="1 {np} 1",
             min_ranks=2),
+    Variant("no_conduction", "no particle-particle conduction: no heat fix, the coupling loop "
+            "integrates the temperatures (run.conduction = false)", no_conduction=True),
     # The time-to-answer reference of issue 11: half the default step (20 steps per Hertz
     # contact at the free-fall speed instead of 10; 10 % of the Rayleigh time is longer for the
     # paper's soft particles) and the moving-mesh shell; then also on the grid across the drum,
@@ -188,6 +195,11 @@ def apply_variant(deck: str, variant: Variant, ranks: int) -> str:
         line = (f"\nfix spin_shell all move/mesh mesh shell rotate origin {m.group(2)} axis {m.group(3)} "
                 f"period {period:.12g}")
         deck = deck[:walls.end()] + line + deck[walls.end():]
+    if variant.no_conduction:
+        # Same fix ID and style as the per-atom temperature heat/gran/conduction creates, so
+        # read_restart hands it the restart's temperatures.
+        deck = _replace_line(deck, r"^fix heat all heat/gran/conduction .*$",
+                             "fix Temp all property/atom Temp scalar yes no no 0.")
     return deck
 
 
@@ -235,7 +247,8 @@ def baseline_deck(rundir: RunDir, restart_step: int, ranks: int, scratch: Path,
 
 
 def _prepare(folder: Path, rundir: RunDir, restart: Path, deck: str, driver: dict[str, Any],
-             end_step: int, time_step_factor: float = 1.0, start_step: int = 0) -> None:
+             end_step: int, time_step_factor: float = 1.0, start_step: int = 0,
+             loop_heat: bool = False) -> None:
     """A run-directory-like folder: case, geometry, the deck, the restart (linked, read only)
     and the coupling loop's input for ``end_step``."""
     if folder.exists():
@@ -256,6 +269,11 @@ def _prepare(folder: Path, rundir: RunDir, restart: Path, deck: str, driver: dic
         spec.update(time_step=dt * time_step_factor,
                     interval=max(1, round(int(driver["interval"]) / time_step_factor)),
                     clock_origin=[start_step, start_step * dt])
+    if loop_heat:
+        # As the DEM stage sets it up for run.conduction = false (drumflow.coupling.spec).
+        thermo = re.search(r"^thermo\s+(\d+)\s*$", deck, flags=re.M)
+        spec.update(heat_capacity=load_case(rundir.case_toml).particles.heat_capacity,
+                    align_every=int(thermo.group(1)) if thermo else int(spec["interval"]))
     (dem / COUPLING_FILE).write_text(json.dumps(spec, indent=2))
 
 
@@ -458,7 +476,7 @@ def run_settings_study(case: Case, run_dir: Path, out: Path, steps: int = 400, r
             folder = scratch / variant.name
             n_steps = variant_steps(steps, variant)
             _prepare(folder, rundir, restart, apply_variant(deck, variant, ranks), driver,
-                     start + n_steps, variant.time_step_factor, start)
+                     start + n_steps, variant.time_step_factor, start, variant.no_conduction)
             t0 = time.perf_counter()
             try:
                 record = runner.run("liggghts", driver_command(runner.profile, ranks, COUPLING_FILE),

@@ -8,7 +8,9 @@ Every N DEM steps each MPI rank reads its own particles' positions, velocities a
 temperatures (numpy views of LIGGGHTS' memory), samples the air there, and writes the
 Schiller-Naumann drag into three per-atom properties that ``fix addforce`` applies at every
 step, and the Ranz-Marshall heat into ``heatSource``, which ``heat/gran/conduction`` adds to
-each particle's energy balance at every step. Then LIGGGHTS runs N steps.
+each particle's energy balance at every step. Then LIGGGHTS runs N steps. Without conduction
+(``run.conduction = false``) the deck has no heat fix: the loop adds each particle's heat over
+the N steps to its temperature itself, the sum LIGGGHTS' transport equation would take.
 
 MPI: ``lammps_open_no_mpi`` starts one LIGGGHTS instance on MPI_COMM_WORLD, so P ranks of this
 script share one domain-decomposed simulation; drag and convection are per particle, so each
@@ -168,6 +170,9 @@ def run(spec_path: Path) -> int:
         return origin_time + (at_step - origin_step) * dt
 
     coarse_grain = float(spec.get("coarse_grain", 1.0))
+    heat_capacity = spec.get("heat_capacity")
+    # Updates end on multiples of this step (0: every `interval` steps from the start).
+    align = int(spec.get("align_every", 0))
 
     interval = int(spec["interval"])
     stride = profile_stride(interval, int(spec.get("profile_every_steps", PROFILE_EVERY_STEPS)))
@@ -199,6 +204,8 @@ def run(spec_path: Path) -> int:
         while step < total:
             started = time.perf_counter()
             n = min(interval, total - step)
+            if align > 0:
+                n = min(n, align - step % align)
             x = lmp.atom_array("x")
             v = lmp.atom_array("v")
             T = lmp.fix_vector("Temp")
@@ -214,7 +221,14 @@ def run(spec_path: Path) -> int:
                 break
             for axis, name in enumerate(DRAG_FIXES):
                 lmp.fix_vector(name)[:] = force[:, axis]
-            lmp.fix_vector("heatSource")[:] = heat
+            if heat_capacity is None:
+                lmp.fix_vector("heatSource")[:] = heat
+            else:
+                # No heat fix: the interval's heat enters now, held constant over the n steps as
+                # heatSource would be. Nothing reads a temperature before the next update (no
+                # conduction; `align_every` puts every thermo row, dump and restart on an update
+                # step), so every temperature seen is the one LIGGGHTS would have integrated.
+                T += heat * (n * dt) / (lmp.atom_vector("rmass") * float(heat_capacity))
             slip = float(np.linalg.norm(u - v, axis=1).mean()) if len(v) else 0.0
             row = (step, clock(step), n, float(heat.sum()), *map(float, force.sum(axis=0)), len(v), slip)
             python_wall = time.perf_counter() - started

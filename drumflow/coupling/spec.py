@@ -51,6 +51,10 @@ class CouplingSpec:
     coarse_grain
         ``particles.coarse_grain`` k: each DEM sphere is a parcel of k**3 particles of 1/k its
         diameter, and receives k**3 times the drag and heat of one of them (1: no parcels).
+    heat_capacity
+        Set (J/(kg K)) when the deck has no heat fix (``run.conduction = false``): the loop
+        then advances each particle's temperature by its heat over the interval itself. None:
+        LIGGGHTS' conduction fix integrates the heat the loop writes into ``heatSource``.
     """
 
     field: dict[str, Any]
@@ -60,12 +64,15 @@ class CouplingSpec:
     pressure_kPa: float
     omega: float
     coarse_grain: float = 1.0
+    heat_capacity: float | None = None
 
     @property
     def key(self) -> str:
         """What the DEM stage's result depends on from the coupling."""
         parcels = f":parcels={self.coarse_grain:.12g}" if self.coarse_grain != 1.0 else ""
-        return f":air={self.field_key}:every={self.interval}{parcels}"
+        # A run whose temperatures the loop integrates has another deck and restart content.
+        loop_heat = ":heat=loop" if self.heat_capacity is not None else ""
+        return f":air={self.field_key}:every={self.interval}{parcels}{loop_heat}"
 
     def driver_file(self, deck: str, log: str, total_steps: int, time_step: float,
                     tail: list[str]) -> dict[str, Any]:
@@ -95,6 +102,7 @@ class CouplingSpec:
             "coupling_log": COUPLING_LOG_PATTERN,
             "tail": tail,
             "coarse_grain": self.coarse_grain,
+            "heat_capacity": self.heat_capacity,
         }
 
     def write_driver_file(self, work: Path, deck: str, log: str, total_steps: int,
@@ -134,6 +142,9 @@ def build_coupling(case: Case, source: FieldSource, time_step: float, dump_every
         pressure_kPa=case.air.pressure_kPa,
         omega=source.omega,
         coarse_grain=case.particles.coarse_grain,
+        # The deck leaves out the conduction fix, which also integrates the temperatures, when
+        # conduction is off (templates/drum.in.j2); the loop integrates them instead.
+        heat_capacity=None if case.run.conduction else case.particles.heat_capacity,
     )
 
 

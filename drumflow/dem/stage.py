@@ -133,6 +133,10 @@ def _add_loop_options(spec_path: Path, case: Case, plan: StepPlan) -> None:
         extra["stop"] = rule
     if case.run.crossings == "loop":
         extra["crossings"] = "loop"
+    if not case.run.conduction:
+        # The loop integrates the temperatures (no heat fix): it ends an update on every thermo
+        # step, so that each temperature LIGGGHTS prints or dumps has all its heat and no more.
+        extra["align_every"] = plan.thermo_every or plan.dump_every
     if not extra:
         return
     spec = json.loads(spec_path.read_text())

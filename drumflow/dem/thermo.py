@@ -109,8 +109,12 @@ def read_thermo(dem_dir: Path, every: int | None = None) -> pd.DataFrame:
         cut = min(later_starts) if later_starts else np.inf
         kept.append(frame[frame["step"] < cut])
     table = pd.concat(kept, ignore_index=True)
-    # `run 0` at the very end repeats the last step: keep one row per step.
-    table = table.sort_values(["step", "attempt"]).drop_duplicates("step", keep="last")
+    # Within an attempt a step can appear twice: at the end of one coupled run and at the start
+    # of the next (or in the final `run 0`). The first is the state at that step; the second
+    # comes after the loop's update, which, when the loop integrates the temperatures itself
+    # (run.conduction = false), has already added the next interval's heat.
+    table = table.drop_duplicates(["attempt", "step"], keep="first")
+    table = table.sort_values(["step", "attempt"], kind="stable").drop_duplicates("step", keep="last")
     table["step"] = table["step"].astype(np.int64)
     if every:
         last = table["step"].max()

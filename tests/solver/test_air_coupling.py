@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -82,5 +83,41 @@ def test_interrupted_coupled_run_resumes_with_its_heat_log(tmp_path: Path) -> No
     # Two attempts logged heat; stitched, the bookkeeping still closes (a row lost or
     # counted twice at the resume would show at 1e-3 or more).
     assert len(list((out / "dem" / "coupling").glob("rank0.*.csv"))) == 2
+    assert summary["energy_balance_error"] < 1e-6
+    assert summary["particles_final"] == 500
+
+
+@pytest.mark.timeout(600)
+def test_conduction_off_loop_integrates_temperatures_across_a_resume(tmp_path: Path) -> None:
+    """run.conduction = false leaves LIGGGHTS' heat fix out and the coupling loop integrates each
+    particle's temperature: on 2 ranks (particles migrate between them) and across an
+    interrupt, the heat the loop logged must still equal the enthalpy LIGGGHTS' temperatures
+    lost, and the per-atom temperatures must come back from the restart."""
+    from drumflow.errors import SolverTimeoutError
+    from drumflow.pipeline import run_case
+    from drumflow.verify.scenes import tiny_drum
+
+    case = tiny_drum(air__model="uniform", air__mass_flow=0.1, run__time=2.0, run__restart_interval=0.1,
+                     run__conduction=False, run__processes=2,
+                     particles__initial_temperature_spread_C=20.0)
+    out = tmp_path / "run"
+    with pytest.raises(SolverTimeoutError):
+        run_case(case, out, timeout=9)
+    summary = run_case(case, out, timeout=300)
+    deck = (out / "dem" / "in.drum").read_text()
+    assert not re.search(r"^fix \S+ all heat/gran", deck, flags=re.M)
+    assert re.search(r"^fix Temp all property/atom Temp ", deck, flags=re.M)
+    assert json.loads((out / "stages" / "dem.json").read_text())["result"]["resumed_from_step"]
+    # The first thermo row of the series is the state before any heat (regression: the row a
+    # coupled `run` prints at its start comes after the loop's update and used to win): the
+    # deck sets x <= 0 to 100 C and the rest to 80 C, equal particles.
+    data = (out / "dem" / "particles.data").read_text().split("Atoms")[1].split()
+    x = [float(v) for v in data[4::7]]
+    expected = 80.0 + 20.0 * sum(v <= 0.0 for v in x) / len(x)
+    assert len(x) == 500
+    assert summary["mean_temperature_initial_C"] == pytest.approx(expected, abs=1e-6)
+    assert summary["mean_temperature_C"] < 90.0 - 0.1
+    # A temperature reset at the resume, a heat row applied twice or not at all, or an update
+    # lost by a particle that changed rank would each show at 1e-3 or more.
     assert summary["energy_balance_error"] < 1e-6
     assert summary["particles_final"] == 500

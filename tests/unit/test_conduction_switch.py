@@ -2,10 +2,13 @@
 
 In LIGGGHTS 3.8 `fix heat/gran` is registered as another name for heat/gran/conduction, so a
 deck that switched to it still conducted: a conduction-off run gave exactly the conduction-on
-temperatures. The deck now keeps heat/gran/conduction (it holds the temperatures and adds the
-air's heat source) with a zero conductivity, for which LIGGGHTS sets every contact's
-conductance to 0. The real-solver half of this regression is
-tests/solver/test_liggghts_drum.py::test_conduction_off_keeps_the_spread_and_fails_the_guard.
+temperatures. Then the deck kept heat/gran/conduction with a zero conductivity, which still
+visited every contact and integrated every temperature at every step (a quarter to a third of
+a paper-scale loop). Now a conduction-off deck has no heat fix at all, only the per-atom
+temperature, and the coupling loop integrates it (``heat_capacity`` in its spec). The
+real-solver halves: tests/solver/test_liggghts_drum.py::
+test_conduction_off_keeps_the_spread_and_fails_the_guard and tests/solver/test_air_coupling.py::
+test_conduction_off_loop_integrates_temperatures_across_a_resume.
 """
 
 from __future__ import annotations
@@ -32,11 +35,30 @@ def _conductivities(deck: str) -> list[float]:
     return [float(v) for v in line.group(1).split()]
 
 
-@pytest.mark.parametrize("conduction", [True, False])
-def test_one_heat_fix_whose_conductivity_follows_the_switch(smoke_dict: dict, conduction: bool) -> None:
-    deck = _deck(smoke_dict, conduction)
+def test_conduction_on_is_one_heat_fix_with_the_paper_conductivity(smoke_dict: dict) -> None:
+    deck = _deck(smoke_dict, True)
     heat = [ln for ln in deck.splitlines() if re.match(r"fix \S+ all heat/gran", ln)]
     assert heat == ["fix heat all heat/gran/conduction initial_temperature 90.0 contact_area overlap "
                     "area_correction yes"]
-    k = liggghts_conductivity(smoke_dict["particles"]["conductivity"]) if conduction else 0.0
+    k = liggghts_conductivity(smoke_dict["particles"]["conductivity"])
     assert _conductivities(deck) == pytest.approx([k, k], rel=1e-8)
+
+
+def test_conduction_off_has_no_heat_fix_and_the_loop_integrates(smoke_dict: dict) -> None:
+    from drumflow.air.source import FieldSource
+    from drumflow.coupling.spec import build_coupling
+
+    deck = _deck(smoke_dict, False)
+    assert not re.search(r"^fix \S+ all heat/gran", deck, flags=re.M)
+    # The temperatures stay, in a per-atom property of the same ID heat/gran/conduction gives
+    # its own (snapshots read f_Temp[0]; a restart of either kind fills it).
+    assert re.search(r"^fix Temp all property/atom Temp scalar yes no no 90\.?0*$", deck, flags=re.M)
+    assert "f_Temp[0]" in deck
+    case = case_from_dict(smoke_dict)
+    source = FieldSource(field={"kind": "uniform", "velocity": [0.0, 0.0, 1.0]}, key="u", omega=0.0)
+    off = build_coupling(case, source, 1e-5, 100)
+    assert off.heat_capacity == smoke_dict["particles"]["heat_capacity"]
+    assert ":heat=loop" in off.key
+    smoke_dict["run"]["conduction"] = True
+    on = build_coupling(case_from_dict(smoke_dict), source, 1e-5, 100)
+    assert on.heat_capacity is None and ":heat=loop" not in on.key

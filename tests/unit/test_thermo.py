@@ -26,3 +26,19 @@ def test_resumed_attempt_supersedes_the_interrupted_one(tmp_path: Path) -> None:
 
 def test_no_logs_gives_empty_table(tmp_path: Path) -> None:
     assert read_thermo(tmp_path).empty
+
+
+def test_a_step_printed_twice_in_one_attempt_keeps_its_first_row(tmp_path: Path) -> None:
+    """Regression: each coupled `run` prints its first step again, after the loop's update; when
+    the loop integrates the temperatures (run.conduction = false) that row already holds the
+    next interval's heat, and keeping it put the series one interval ahead (the smoke drum's
+    energy balance was off by 0.3 %)."""
+    row = "{} {} 500 0.1 0.01 {} 1.0 \n"
+    first_run = HEADER + row.format(0, 0.0, 90.0) + row.format(10, 0.01, 89.0) + "Loop time of 1\n"
+    # The second run starts at 89.0 at step 10 but prints 88.0 there, after the update.
+    second_run = HEADER + row.format(10, 0.01, 88.0) + row.format(20, 0.02, 87.0) + "Loop time of 1\n"
+    banner = "LIGGGHTS (Version LIGGGHTS-PUBLIC 3.8.0)\n"
+    (tmp_path / "log.liggghts").write_text(banner + first_run + second_run)
+    table = read_thermo(tmp_path)
+    assert table["step"].tolist() == [0, 10, 20]
+    assert table["T_mean"].tolist() == [90.0, 89.0, 87.0]
