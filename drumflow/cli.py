@@ -9,6 +9,7 @@ interrupted (rerun the same command to resume).
 from __future__ import annotations
 
 import json
+import signal
 import sys
 import time
 from pathlib import Path
@@ -689,6 +690,10 @@ guard_every_command(app)
 
 def main() -> None:
     """Console-script entry point."""
+    # SIGTERM (`kill`, a SLURM time limit, the end of a login session) ends a command as Ctrl-C
+    # does: the runner stops the solver's process group and the run resumes from its restart.
+    # Python's default would end the CLI at once and leave mpirun and its ranks running.
+    signal.signal(signal.SIGTERM, signal.default_int_handler)
     try:
         app()
     except KeyboardInterrupt:  # Ctrl-C outside a command (while parsing arguments)

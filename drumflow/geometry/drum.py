@@ -14,9 +14,11 @@ have.
 from __future__ import annotations
 
 import math
+import signal
+import threading
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -113,17 +115,34 @@ def _classify_surfaces(length: float, tol: float) -> dict[str, list[int]]:
     return groups
 
 
+#: The signals whose Python handlers a gmsh session must leave as it found them.
+_KEPT_SIGNALS = (signal.SIGINT, signal.SIGTERM)
+
+
+def _reinstall_python_handlers(saved: dict[signal.Signals, Any]) -> None:
+    """Hand the signals back to Python's handlers: gmsh.initialize resets SIGTERM to the default
+    action in C (Python's own record still names its handler), so a `kill` of the CLI ended it
+    at once and left mpirun running. Only the main thread may set handlers."""
+    if threading.current_thread() is not threading.main_thread():
+        return
+    for sig, handler in saved.items():
+        if handler is not None:
+            signal.signal(sig, handler)
+
+
 class _Gmsh:
     """Context manager for one gmsh session (gmsh keeps global state; always finalize)."""
 
     def __enter__(self) -> None:
         import gmsh
 
+        self._saved = {sig: signal.getsignal(sig) for sig in _KEPT_SIGNALS}
         if gmsh.isInitialized():
             gmsh.finalize()
         # interruptible=False: gmsh would otherwise install its own SIGINT handler, and
         # Ctrl-C must reach drumflow's runner instead.
         gmsh.initialize(interruptible=False)
+        _reinstall_python_handlers(self._saved)
         gmsh.option.setNumber("General.Terminal", 0)
         gmsh.option.setNumber("General.Verbosity", 1)
 
@@ -131,6 +150,7 @@ class _Gmsh:
         import gmsh
 
         gmsh.finalize()
+        _reinstall_python_handlers(self._saved)
 
 
 def build_wall_mesh(case: Case, size: float | None = None, with_lifters: bool = True) -> WallMesh:

@@ -201,9 +201,12 @@ def test_failing_solver_exits_1_with_a_message(command: str, tmp_path: Path,
     assert "failsonpurpose" in text or "failedrung" in text, proc.stderr[-3000:]
 
 
-def test_interrupted_run_exits_130_and_leaves_no_solver(tmp_path: Path,
+@pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM])
+def test_interrupted_run_exits_130_and_leaves_no_solver(signum: int, tmp_path: Path,
                                                         failing_solvers: dict[str, str]) -> None:
-    # The launcher sleeps instead of failing: Ctrl-C (SIGINT) arrives while it runs.
+    # The launcher sleeps instead of failing: Ctrl-C (SIGINT) or a SIGTERM (kill, a batch time
+    # limit) arrives while it runs. Regression for SIGTERM: the CLI died at once and left
+    # mpirun and its ranks running on.
     launcher = Path(failing_solvers["DRUMFLOW_MPIRUN"])
     marker = tmp_path / "launcher.pid"
     launcher.write_text(f"#!/bin/sh\necho $$ > {marker}\nexec sleep 120\n")
@@ -223,11 +226,12 @@ def test_interrupted_run_exits_130_and_leaves_no_solver(tmp_path: Path,
         while not marker.exists() and time.monotonic() < deadline and proc.poll() is None:
             time.sleep(0.2)
         assert marker.exists(), "the DEM stage never started its launcher"
-        proc.send_signal(signal.SIGINT)
+        proc.send_signal(signum)
         try:
             _, err = proc.communicate(timeout=60)
         except subprocess.TimeoutExpired:
-            pytest.fail(f"the CLI still ran 60 s after SIGINT (SIGINT in the test process: {inherited})")
+            pytest.fail(f"the CLI still ran 60 s after {signal.Signals(signum).name} "
+                        f"(SIGINT in the test process: {inherited})")
     finally:
         if proc.poll() is None:
             proc.kill()
