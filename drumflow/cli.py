@@ -17,13 +17,12 @@ from typing import Annotated, Any
 
 import typer
 from rich import box
-from rich.console import Console
 from rich.table import Table
 
 from drumflow.cli_cooler import app as cooler_app
 from drumflow.cli_cooler.drum import drum as plant
 from drumflow.cli_export import export
-from drumflow.cli_guard import guard_every_command
+from drumflow.cli_guard import cli_console, guard_every_command
 from drumflow.cli_paper import paper
 from drumflow.cli_progress import StageProgress
 from drumflow.cli_sweep import sweep
@@ -34,8 +33,8 @@ app = typer.Typer(
     pretty_exceptions_enable=False,
     help="CFD-DEM studies of flighted rotary-drum coolers (LIGGGHTS, OpenFOAM).",
 )
-console = Console()
-err_console = Console(stderr=True)
+console = cli_console()
+err_console = cli_console(stderr=True)
 app.add_typer(cooler_app, name="cooler")
 app.command("sweep")(sweep)
 app.command("paper")(paper)

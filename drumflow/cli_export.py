@@ -12,12 +12,12 @@ from pathlib import Path
 from typing import Annotated, Optional
 
 import typer
-from rich.console import Console
 from rich.table import Table
 
+from drumflow.cli_guard import cli_console
 from drumflow.errors import RunDirectoryError
 
-console = Console()
+console = cli_console()
 
 
 def export(

@@ -10,6 +10,8 @@ traceback.
 from __future__ import annotations
 
 import functools
+import os
+import sys
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from typing import Any
@@ -20,9 +22,22 @@ from rich.markup import escape
 
 from drumflow.errors import DrumflowError, exit_code
 
-__all__ = ["guard", "guard_every_command"]
+__all__ = ["cli_console", "guard", "guard_every_command"]
 
-_err_console = Console(stderr=True)
+#: Width of a command's tables off a terminal (a log, a pipe, a batch job's output): rich's
+#: default there is 80 columns, which cut the bench and summary tables' columns to "…".
+LOG_WIDTH = 200
+
+
+def cli_console(stderr: bool = False) -> Console:
+    """The console a command writes to: the terminal's width on a terminal (or ``COLUMNS``),
+    :data:`LOG_WIDTH` columns in a file or pipe."""
+    stream = sys.stderr if stderr else sys.stdout
+    wide = not os.environ.get("COLUMNS") and not (hasattr(stream, "isatty") and stream.isatty())
+    return Console(stderr=stderr, width=LOG_WIDTH if wide else None)
+
+
+_err_console = cli_console(stderr=True)
 
 
 @contextmanager

@@ -19,15 +19,15 @@ from pathlib import Path
 from typing import Annotated, Any, Optional
 
 import typer
-from rich.console import Console
 from rich.markup import escape
 from rich.table import Table
 
+from drumflow.cli_guard import cli_console
 from drumflow.cli_progress import StageProgress
 from drumflow.errors import CaseError, DrumflowError
 
-console = Console()
-err_console = Console(stderr=True)
+console = cli_console()
+err_console = cli_console(stderr=True)
 
 _MODELS: dict[str, tuple[str, ...]] = {"one": ("one",), "two": ("two",), "both": ("one", "two")}
 _CASE_FILES = {"one": "paper_model_one.toml", "two": "paper_model_two.toml"}

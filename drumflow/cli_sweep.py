@@ -14,15 +14,15 @@ from pathlib import Path
 from typing import Annotated, Any, Optional
 
 import typer
-from rich.console import Console
 from rich.live import Live
 from rich.markup import escape
 from rich.table import Table
 
+from drumflow.cli_guard import cli_console
 from drumflow.errors import DrumflowError, exit_code
 
-console = Console()
-err_console = Console(stderr=True)
+console = cli_console()
+err_console = cli_console(stderr=True)
 
 _STYLE = {"done": "green", "running": "cyan", "pending": "white", "failed": "bold red",
           "interrupted": "yellow"}

@@ -11,8 +11,8 @@ from __future__ import annotations
 from contextlib import AbstractContextManager
 
 import typer
-from rich.console import Console
 
+from drumflow.cli_guard import cli_console
 from drumflow.cli_guard import guard as shared_guard
 
 app = typer.Typer(
@@ -22,8 +22,8 @@ app = typer.Typer(
     help="Reduced-order models of whole coolers: particle curtain, rotary drum, vibrating "
     "fluid bed with refrigeration, clinker grate cooler (seconds, no solver).",
 )
-console = Console()
-err_console = Console(stderr=True)
+console = cli_console()
+err_console = cli_console(stderr=True)
 
 
 def guard() -> AbstractContextManager[None]:

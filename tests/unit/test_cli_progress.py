@@ -62,3 +62,25 @@ def test_a_terminal_gets_bars_not_lines() -> None:
         assert not progress.plain
         progress("dem", 0.5, 1.0)
     assert "0.500/1.000 s simulated" in buffer.getvalue()
+
+
+def test_tables_off_a_terminal_are_not_cut_at_80_columns(monkeypatch) -> None:
+    """Regression: in a log or pipe rich drew every table 80 columns wide and cut the bench's
+    and the summary's columns to "…"."""
+    import io
+
+    from rich.table import Table
+
+    from drumflow.cli_guard import LOG_WIDTH, cli_console
+
+    monkeypatch.delenv("COLUMNS", raising=False)
+    monkeypatch.setattr("sys.stdout", io.StringIO())
+    console = cli_console()
+    assert console.width == LOG_WIDTH
+    table = Table("variant", "particle_steps_per_s", "speedup_vs_baseline", "physics_ok", "description")
+    table.add_row("no_conduction", "2,021,690", "1.29", "True", "no heat fix, the loop integrates")
+    console.print(table)
+    text = console.file.getvalue()  # type: ignore[attr-defined]
+    assert "particle_steps_per_s" in text and "…" not in text
+    monkeypatch.setenv("COLUMNS", "100")
+    assert cli_console().width == 100
