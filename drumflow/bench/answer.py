@@ -86,7 +86,7 @@ from drumflow.convergence import (
     decide,
     mser_truncation,
 )
-from drumflow.coupling.log import read_coupling, update_walls
+from drumflow.coupling.log import measured_rate, read_coupling, update_walls
 from drumflow.coupling.stop import StopMonitor, min_stop_time, rule_inputs
 from drumflow.errors import (
     AnalysisInputError,
@@ -686,7 +686,7 @@ def _wall_per_update(run: RunDir, updates: pd.DataFrame, dt: float,
     have = np.isfinite(measured)
     rate_source = "argument particle_steps_per_s"
     if rate is None and not logged.empty:
-        rate = float((logged["particles"] * logged["steps"]).sum() / logged["wall_s"].sum())
+        rate = measured_rate(logged)
         rate_source = (f"the {len(logged)} coupling updates with logged wall times "
                        f"({float(logged['time_s'].min()):.4g}-{float(logged['time_s'].max()):.4g} s "
                        "simulated): the speed of the code that ran them")

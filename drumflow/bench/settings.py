@@ -48,7 +48,7 @@ import pandas as pd
 
 from drumflow.bench.profile import profile_run
 from drumflow.case import Case, load_case
-from drumflow.coupling.spec import COUPLING_FILE, CouplingSpec, driver_command
+from drumflow.coupling.spec import COUPLING_FILE, CouplingSpec, driver_command, loop_heat_options
 from drumflow.dem.deck import processors_grid
 from drumflow.dem.stage import DemInputs, finished_loop, latest_restart, write_deck
 from drumflow.dem.thermo import read_thermo
@@ -270,10 +270,10 @@ def _prepare(folder: Path, rundir: RunDir, restart: Path, deck: str, driver: dic
                     interval=max(1, round(int(driver["interval"]) / time_step_factor)),
                     clock_origin=[start_step, start_step * dt])
     if loop_heat:
-        # As the DEM stage sets it up for run.conduction = false (drumflow.coupling.spec).
+        # As the DEM stage sets it up for run.conduction = false.
         thermo = re.search(r"^thermo\s+(\d+)\s*$", deck, flags=re.M)
-        spec.update(heat_capacity=load_case(rundir.case_toml).particles.heat_capacity,
-                    align_every=int(thermo.group(1)) if thermo else int(spec["interval"]))
+        spec.update(loop_heat_options(load_case(rundir.case_toml).particles.heat_capacity,
+                                      int(thermo.group(1)) if thermo else int(spec["interval"])))
     (dem / COUPLING_FILE).write_text(json.dumps(spec, indent=2))
 
 

@@ -110,6 +110,12 @@ def update_walls(coupling: pd.DataFrame) -> pd.DataFrame:
     return logged.assign(paused=logged["wall_s"] > PAUSED_FACTOR * median)
 
 
+def measured_rate(updates: pd.DataFrame) -> float:
+    """Particle-steps per wall second of logged, unpaused updates (:func:`update_walls` rows):
+    the speed of the code that ran them, the one rate every wall-time estimate uses."""
+    return float((updates["particles"] * updates["steps"]).sum() / updates["wall_s"].sum())
+
+
 def coupled_wall_s(coupling: pd.DataFrame) -> dict[str, float | int] | None:
     """Wall seconds the coupling loop computed, over every attempt of a run.
 
@@ -128,7 +134,7 @@ def coupled_wall_s(coupling: pd.DataFrame) -> dict[str, float | int] | None:
     good = logged[~logged["paused"].astype(bool)]
     if good.empty:
         return None
-    rate = float((good["particles"] * good["steps"]).sum() / good["wall_s"].sum())
+    rate = measured_rate(good)
     rest = coupling[~coupling["step"].isin(good["step"])]
     estimated = float((rest["particles"] * rest["steps"]).sum() / rate)
     measured = float(good["wall_s"].sum())

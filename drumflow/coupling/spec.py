@@ -22,7 +22,8 @@ if TYPE_CHECKING:
     from drumflow.case import Case
     from drumflow.runner import LaunchProfile
 
-__all__ = ["COUPLING_FILE", "CouplingSpec", "FieldSource", "build_coupling", "driver_command"]
+__all__ = ["COUPLING_FILE", "CouplingSpec", "FieldSource", "build_coupling", "driver_command",
+           "loop_heat_options"]
 
 #: The coupling loop's input file, in the DEM working directory.
 COUPLING_FILE = "coupling.json"
@@ -75,7 +76,7 @@ class CouplingSpec:
         return f":air={self.field_key}:every={self.interval}{parcels}{loop_heat}"
 
     def driver_file(self, deck: str, log: str, total_steps: int, time_step: float,
-                    tail: list[str]) -> dict[str, Any]:
+                    tail: list[str], thermo_every: int = 0) -> dict[str, Any]:
         """The coupling loop's input (:func:`drumflow.coupling.driver.run` reads these keys).
 
         Parameters
@@ -88,7 +89,12 @@ class CouplingSpec:
             DEM time step, s.
         tail
             LIGGGHTS commands run after the loop (final restart, end of dumps).
+        thermo_every
+            The deck's thermo step; needed when the loop integrates the temperatures
+            (:attr:`heat_capacity` set, see :func:`loop_heat_options`).
         """
+        loop_heat = ({} if self.heat_capacity is None
+                     else loop_heat_options(self.heat_capacity, thermo_every))
         return {
             "deck": deck,
             "log": log,
@@ -103,15 +109,38 @@ class CouplingSpec:
             "tail": tail,
             "coarse_grain": self.coarse_grain,
             "heat_capacity": self.heat_capacity,
+            **loop_heat,
         }
 
     def write_driver_file(self, work: Path, deck: str, log: str, total_steps: int,
-                          time_step: float, tail: list[str]) -> Path:
+                          time_step: float, tail: list[str], thermo_every: int = 0) -> Path:
         """Write :meth:`driver_file` to ``work / COUPLING_FILE`` and return its path."""
         path = work / COUPLING_FILE
-        path.write_text(json.dumps(self.driver_file(deck, log, total_steps, time_step, tail),
-                                   indent=2))
+        path.write_text(json.dumps(self.driver_file(deck, log, total_steps, time_step, tail,
+                                                    thermo_every), indent=2))
         return path
+
+
+def loop_heat_options(heat_capacity: float, thermo_every: int) -> dict[str, Any]:
+    """The coupling loop's keys when it integrates the particles' temperatures itself.
+
+    A deck without LIGGGHTS' heat fix (``run.conduction = false``) has only a per-atom
+    ``Temp``: the loop adds each particle's heat over an update, ``heat * n * dt / (m * cp)``.
+    It must then end an update on every thermo step (``align_every``), so that each
+    temperature LIGGGHTS prints or dumps has all its heat and no more. The one place this rule
+    lives: the DEM stage and ``drumflow bench --from`` both take it from here.
+
+    Raises
+    ------
+    ValueError
+        ``heat_capacity`` not positive, or ``thermo_every`` not a positive number of steps.
+    """
+    if not (math.isfinite(heat_capacity) and heat_capacity > 0.0):
+        raise ValueError(f"heat_capacity = {heat_capacity!r}: a positive J/(kg K) is needed")
+    if thermo_every < 1:
+        raise ValueError(f"thermo_every = {thermo_every!r}: the deck's thermo step, at least 1, "
+                         "is needed when the coupling loop integrates the temperatures")
+    return {"heat_capacity": float(heat_capacity), "align_every": int(thermo_every)}
 
 
 def coupling_interval(case: Case, time_step: float, dump_every: int) -> int:

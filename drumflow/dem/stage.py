@@ -133,10 +133,6 @@ def _add_loop_options(spec_path: Path, case: Case, plan: StepPlan) -> None:
         extra["stop"] = rule
     if case.run.crossings == "loop":
         extra["crossings"] = "loop"
-    if not case.run.conduction:
-        # The loop integrates the temperatures (no heat fix): it ends an update on every thermo
-        # step, so that each temperature LIGGGHTS prints or dumps has all its heat and no more.
-        extra["align_every"] = plan.thermo_every or plan.dump_every
     if not extra:
         return
     spec = json.loads(spec_path.read_text())
@@ -355,7 +351,8 @@ def _launch(case: Case, rundir: RunDir, runner: Runner, inputs: DemInputs, deck_
     else:
         spec_path = inputs.coupling.write_driver_file(work, deck_name, own_log.name,
                                                       inputs.plan.steps, inputs.plan.time_step,
-                                                      end_commands(context))
+                                                      end_commands(context),
+                                                      inputs.plan.thermo_every or inputs.plan.dump_every)
         _add_loop_options(spec_path, case, inputs.plan)
         command = driver_command(runner.profile, inputs.processes, COUPLING_FILE)
     watcher = _RowWatcher(case, inputs, own_log, rundir.dem_restart, rundir.dem_dumps, resumed_from)

@@ -62,3 +62,25 @@ def test_conduction_off_has_no_heat_fix_and_the_loop_integrates(smoke_dict: dict
     smoke_dict["run"]["conduction"] = True
     on = build_coupling(case_from_dict(smoke_dict), source, 1e-5, 100)
     assert on.heat_capacity is None and ":heat=loop" not in on.key
+
+
+def test_loop_heat_driver_file_aligns_updates_on_the_thermo_step(smoke_dict: dict) -> None:
+    """One owner of the loop-heat keys: the spec writes heat capacity and alignment together,
+    and refuses a loop-heat driver without the thermo step (updates would straddle rows)."""
+    from drumflow.air.source import FieldSource
+    from drumflow.coupling.spec import build_coupling, loop_heat_options
+
+    smoke_dict["run"]["conduction"] = False
+    case = case_from_dict(smoke_dict)
+    source = FieldSource(field={"kind": "uniform", "velocity": [0.0, 0.0, 1.0]}, key="u", omega=0.0)
+    off = build_coupling(case, source, 1e-5, 100)
+    driver = off.driver_file("d", "l", 1000, 1e-5, [], thermo_every=200)
+    assert driver["align_every"] == 200
+    assert driver["heat_capacity"] == smoke_dict["particles"]["heat_capacity"]
+    with pytest.raises(ValueError, match="thermo_every"):
+        off.driver_file("d", "l", 1000, 1e-5, [])
+    with pytest.raises(ValueError, match="heat_capacity"):
+        loop_heat_options(0.0, 200)
+    smoke_dict["run"]["conduction"] = True
+    on = build_coupling(case_from_dict(smoke_dict), source, 1e-5, 100)
+    assert "align_every" not in on.driver_file("d", "l", 1000, 1e-5, [])
