@@ -107,6 +107,9 @@ def test_settings_study_from_the_restart(run: Path, tmp_path: Path) -> None:
     deck = (out.parent / "variants" / "skin_x2" / "dem" / "in.drum.resume").read_text()
     base = (out.parent / "variants" / "baseline" / "dem" / "in.drum.resume").read_text()
     assert deck != base and "neighbor        0.008 bin" in deck
+    # The overlap compute is dropped from the thermo rows, their columns kept for the readers.
+    quiet = (out.parent / "variants" / "no_overlap" / "dem" / "in.drum.resume").read_text()
+    assert "c_overlap_max" in base and "c_overlap_max" not in quiet and "v_no_overlap" in quiet
     # The conservative reference: half the step, the shell a rotating mesh, and the air clock
     # continuing from the restart's time (not step x the new step).
     folder = out.parent / "variants" / "conservative" / "dem"
