@@ -88,6 +88,19 @@ def ranz_marshall_h(
     return nu * air.conductivity / d
 
 
+def ranz_marshall_slip(h: float, diameter: float, air: AirState) -> float:
+    """The slip speed, m/s, at which :func:`ranz_marshall_h` gives ``h``: Eq. 23 solved for Re.
+
+    Used to say what air speed a published h needs in the same correlation. NaN when ``h`` is
+    at or below the still-air limit ``2 k / d`` (no slip gives less).
+    """
+    nu = h * diameter / air.conductivity
+    root_re = (0.5 * nu - 1.0) / (0.3 * air.prandtl ** (1.0 / 3.0))
+    if not root_re > 0.0:
+        return math.nan
+    return float(root_re**2 * air.viscosity / (air.density * diameter))
+
+
 def convective_heat(
     air_velocity: NDArray[np.float64],
     particle_velocity: NDArray[np.float64],

@@ -59,6 +59,7 @@ from drumflow.analysis.paper import (
     temperature_at,
 )
 from drumflow.case import Case, load_case
+from drumflow.coupling.physics import AirState, ranz_marshall_slip
 from drumflow.errors import AnalysisInputError, DrumflowError, RunDirectoryError
 from drumflow.report.animation import ANIMATION, render_animation
 from drumflow.report.html import (
@@ -631,6 +632,15 @@ def _h_table(run: PaperRun) -> _Table:
              f"{_fmt(a.get('airborne'))} particles, slip {_fmt(a.get('slip_airborne_m_s'), 3)} m/s, "
              + (f"{share:.1%} of the heat" if isinstance(share, (int, float)) else "")],
         ]
+    if run.case is not None:
+        # What air speed the paper's h needs in the correlation drumflow applies (Eq. 23), to
+        # set beside the slip the particles see: the measured source of the h difference.
+        air = AirState.at(run.case.air.inlet_temperature_C, run.case.air.pressure_kPa)
+        slip = ranz_marshall_slip(paper.h_w_m2k, run.case.particles.diameter, air)
+        seen = a.get("slip_mean_m_s") if a is not None else None
+        rows.append(["slip speed the paper's h needs in Ranz-Marshall (Eq. 23), m/s", _fmt(slip, 3),
+                     f"the particles see {_fmt(seen, 3)} m/s (last snapshot, mean)"
+                     if isinstance(seen, (int, float)) else ""])
     if run.case is not None and run.methodology is not None:
         surface = run.case.particle_count * math.pi * run.case.particles.diameter**2
         rows += [

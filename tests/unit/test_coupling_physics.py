@@ -137,3 +137,16 @@ def test_coupling_log_sums_ranks_and_supersedes_attempts(tmp_path: Path) -> None
     # Each row's heat is applied for 10 steps of 0.01 s: 0.3 + 0.3 + 0.4 J.
     assert table["heat_removed_J"].iloc[-1] == pytest.approx(1.0)
     assert read_coupling(tmp_path / "none", 0.01).empty
+
+
+def test_ranz_marshall_slip_inverts_the_correlation() -> None:
+    """The slip a published h needs: Eq. 23 solved for Re gives back h, and below the
+    still-air limit 2 k / d no slip gives it (NaN, not a negative speed)."""
+    from drumflow.coupling.physics import ranz_marshall_slip
+
+    air = AirState.at(30.0, 101.3)
+    for h, d in ((60.15, 0.008), (38.93, 0.02), (500.0, 0.001)):
+        v = ranz_marshall_slip(h, d, air)
+        assert v > 0.0
+        assert float(ranz_marshall_h(v, d, air)) == pytest.approx(h, rel=1e-12)
+    assert math.isnan(ranz_marshall_slip(0.99 * 2.0 * air.conductivity / 0.008, 0.008, air))

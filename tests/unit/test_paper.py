@@ -6,6 +6,7 @@ from __future__ import annotations
 import csv
 import json
 import math
+import re
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -252,6 +253,9 @@ def test_page_and_tables_from_synthetic_runs(paper_dirs: Path, tmp_path: Path) -
     for text in ("Table 8 beside the paper", "Table 8b.", "Figure 9", "Figure 4", "Figure 7",
                  "Figure 8", "Figure 6", "what h is", "1.667"):
         assert text in html, text
+    # The slip the paper's h needs in Eq. 23 (8 mm at 30 °C: 1.82 m/s), beside what the
+    # particles see: the measured source of the h difference.
+    assert re.search(r"slip speed the paper&#39;s h needs[^<]*</td><td>1\.82</td>", html)
     assert "http://" not in html and "https://" not in html  # self-contained
 
 
