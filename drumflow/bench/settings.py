@@ -48,7 +48,13 @@ import pandas as pd
 
 from drumflow.bench.profile import profile_run
 from drumflow.case import Case, load_case
-from drumflow.coupling.spec import COUPLING_FILE, CouplingSpec, driver_command, loop_heat_options
+from drumflow.coupling.spec import (
+    COUPLING_FILE,
+    OVERLAP_OFF,
+    CouplingSpec,
+    driver_command,
+    loop_heat_options,
+)
 from drumflow.dem.deck import processors_grid
 from drumflow.dem.stage import DemInputs, finished_loop, latest_restart, write_deck
 from drumflow.dem.thermo import read_thermo
@@ -95,9 +101,12 @@ class Variant:
         temperatures go into a plain per-atom ``Temp``), and the coupling loop integrates the
         temperatures. Changes the physics a user set: the row says what it does to the answer.
     no_overlap
-        The thermo rows without the largest-overlap column (a constant 0 in its place), so
-        that LIGGGHTS does not gather every contact's overlap on each thermo step: the cost of
+        The thermo rows without the largest-overlap column (a constant in its place), so
+        that LIGGGHTS does not gather every contact's overlap on any thermo step: the cost of
         the stability monitor's overlap check. Output only: the trajectories are the same.
+    overlap_every_row
+        The overlap column evaluated on every thermo row, as before the coupling loop left it
+        out of most (``overlap_every``).
     """
 
     name: str
@@ -111,6 +120,7 @@ class Variant:
     moving_shell: bool = False
     no_conduction: bool = False
     no_overlap: bool = False
+    overlap_every_row: bool = False
 
 
 #: What is compared. The deck's own settings are the baseline: ``neighbor SKIN bin`` (half a
@@ -135,6 +145,8 @@ VARIANTS: list[Variant] = [
             "integrates the temperatures (run.conduction = false)", no_conduction=True),
     Variant("no_overlap", "thermo rows without the largest-overlap compute (the stability "
             "monitor's overlap check)", no_overlap=True),
+    Variant("overlap_every_row", "the largest-overlap compute on every thermo row (drumflow "
+            "before the loop evaluated it on every 10th)", overlap_every_row=True),
     # The time-to-answer reference of issue 11: half the default step (20 steps per Hertz
     # contact at the free-fall speed instead of 10; 10 % of the Rayleigh time is longer for the
     # paper's soft particles) and the moving-mesh shell; then also on the grid across the drum,
@@ -208,12 +220,16 @@ def apply_variant(deck: str, variant: Variant, ranks: int) -> str:
         deck = _replace_line(deck, r"^fix heat all heat/gran/conduction .*$",
                              "fix Temp all property/atom Temp scalar yes no no 0.")
     if variant.no_overlap:
-        m = re.search(r"^thermo_style\s+.*\bc_overlap_max\b.*$", deck, flags=re.M)
-        if m is None:
-            raise SettingsStudyError("deck: no thermo_style line with c_overlap_max")
         # An unreferenced compute is never evaluated; the column keeps its place for the readers.
-        line = m.group(0).replace("c_overlap_max", "v_no_overlap")
-        deck = deck[:m.start()] + "variable        no_overlap equal 0.0\n" + line + deck[m.end():]
+        if re.search(r"^variable\s+overlap\s+equal\s+c_overlap_max\s*$", deck, flags=re.M):
+            deck = _replace_line(deck, r"^variable\s+overlap\s+equal\s+.*$", OVERLAP_OFF)
+        else:  # a deck from before the overlap variable
+            m = re.search(r"^thermo_style\s+.*\bc_overlap_max\b.*$", deck, flags=re.M)
+            if m is None:
+                raise SettingsStudyError("deck: no thermo_style line with c_overlap_max")
+            line = m.group(0).replace("c_overlap_max", "v_no_overlap")
+            deck = (deck[:m.start()] + OVERLAP_OFF.replace("overlap", "no_overlap", 1) + "\n"
+                    + line + deck[m.end():])
     return deck
 
 
@@ -262,7 +278,7 @@ def baseline_deck(rundir: RunDir, restart_step: int, ranks: int, scratch: Path,
 
 def _prepare(folder: Path, rundir: RunDir, restart: Path, deck: str, driver: dict[str, Any],
              end_step: int, time_step_factor: float = 1.0, start_step: int = 0,
-             loop_heat: bool = False) -> None:
+             loop_heat: bool = False, overlap_every_row: bool = False) -> None:
     """A run-directory-like folder: case, geometry, the deck, the restart (linked, read only)
     and the coupling loop's input for ``end_step``."""
     if folder.exists():
@@ -283,6 +299,9 @@ def _prepare(folder: Path, rundir: RunDir, restart: Path, deck: str, driver: dic
         spec.update(time_step=dt * time_step_factor,
                     interval=max(1, round(int(driver["interval"]) / time_step_factor)),
                     clock_origin=[start_step, start_step * dt])
+    if overlap_every_row:
+        # The loop leaves the deck's overlap formula alone: every row (or none) evaluates it.
+        spec.pop("overlap_every", None)
     if loop_heat:
         # As the DEM stage sets it up for run.conduction = false.
         thermo = re.search(r"^thermo\s+(\d+)\s*$", deck, flags=re.M)
@@ -490,7 +509,8 @@ def run_settings_study(case: Case, run_dir: Path, out: Path, steps: int = 400, r
             folder = scratch / variant.name
             n_steps = variant_steps(steps, variant)
             _prepare(folder, rundir, restart, apply_variant(deck, variant, ranks), driver,
-                     start + n_steps, variant.time_step_factor, start, variant.no_conduction)
+                     start + n_steps, variant.time_step_factor, start, variant.no_conduction,
+                     overlap_every_row=variant.overlap_every_row or variant.no_overlap)
             t0 = time.perf_counter()
             try:
                 record = runner.run("liggghts", driver_command(runner.profile, ranks, COUPLING_FILE),

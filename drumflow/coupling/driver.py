@@ -43,6 +43,7 @@ from numpy.typing import NDArray
 from drumflow.coupling.crossings import CrossingTracker
 from drumflow.coupling.library import Liggghts
 from drumflow.coupling.physics import AirState, convective_heat, drag_force
+from drumflow.coupling.spec import OVERLAP_OFF, OVERLAP_ON
 from drumflow.coupling.stop import StopMonitor
 
 #: Per-atom properties the deck defines for the drag (``fix addforce`` reads them).
@@ -118,6 +119,12 @@ def _finalize_mpi() -> None:
         pass
 
 
+def overlap_wanted(step: int, n: int, every: int, total: int) -> bool:
+    """Whether the run of ``n`` steps from ``step`` evaluates the overlap column: it reaches a
+    multiple of ``every`` (its last thermo row is then one), or it is the run's last."""
+    return (step + n) // every > step // every or step + n >= total
+
+
 def profile_stride(interval: int, every_steps: int = PROFILE_EVERY_STEPS) -> int:
     """Coupling intervals between two timing breakdowns: the whole number of intervals closest to
     ``every_steps`` DEM steps, at least one."""
@@ -173,6 +180,10 @@ def run(spec_path: Path) -> int:
     heat_capacity = spec.get("heat_capacity")
     # Updates end on multiples of this step (0: every `interval` steps from the start).
     align = int(spec.get("align_every", 0))
+    # The thermo rows' overlap column gathers every contact; with `overlap_every` it is
+    # evaluated only in the runs that reach a multiple of it (and the last), -1 elsewhere.
+    overlap_every = int(spec.get("overlap_every", 0))
+    overlap_on = True  # the deck's own formula
 
     interval = int(spec["interval"])
     stride = profile_stride(interval, int(spec.get("profile_every_steps", PROFILE_EVERY_STEPS)))
@@ -244,6 +255,11 @@ def run(spec_path: Path) -> int:
             # need not rebuild neighbour lists or re-initialise the fixes (the loop's cost).
             # `post yes` every `stride` updates and at the end: the timing breakdown.
             post = "yes" if updates % stride == 0 or step + n >= total else "no"
+            if overlap_every > 0:
+                wanted = overlap_wanted(step, n, overlap_every, total)
+                if wanted != overlap_on:
+                    lmp.command(OVERLAP_ON if wanted else OVERLAP_OFF)
+                    overlap_on = wanted
             ran = time.perf_counter()
             lmp.command(f"run {n} pre no post {post}")
             out.write(f",{time.perf_counter() - ran:.6g}\n")

@@ -29,6 +29,12 @@ __all__ = ["COUPLING_FILE", "CouplingSpec", "FieldSource", "build_coupling", "dr
 COUPLING_FILE = "coupling.json"
 #: Where each rank of the loop writes its log, relative to the DEM working directory.
 COUPLING_LOG_PATTERN = "coupling/rank{rank}.{start}.csv"
+#: The deck's thermo column ``v_overlap`` (drumflow.dem.thermo) on the rows the loop leaves the
+#: contact gather out of (spec key ``overlap_every``): below any overlap.
+OVERLAP_NOT_EVALUATED = -1.0
+#: The loop's two formulas for that column.
+OVERLAP_ON = "variable overlap equal c_overlap_max"
+OVERLAP_OFF = f"variable overlap equal {OVERLAP_NOT_EVALUATED:g}"
 #: Standard gravity, m/s^2 (the slip bound of the 'auto' interval).
 GRAVITY = 9.81
 

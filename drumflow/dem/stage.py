@@ -35,6 +35,7 @@ from drumflow.dem.dumps import pack_dumps
 from drumflow.dem.placement import place_particles, write_data_file
 from drumflow.dem.stability import (
     LOST_PREFIX,
+    OVERLAP_EVERY_ROWS,
     StabilityLimits,
     StabilityMonitor,
     stability_limits,
@@ -125,16 +126,14 @@ class DemResult:
 
 
 def _add_loop_options(spec_path: Path, case: Case, plan: StepPlan) -> None:
-    """Give the coupling loop the 'converged' stop rule and the in-memory crossings (nothing
-    for a fixed-time run with the crossing dump: its input stays as it was)."""
-    extra: dict[str, Any] = {}
+    """Give the coupling loop the 'converged' stop rule, the in-memory crossings and the rows
+    the overlap bound is evaluated on (:data:`~drumflow.dem.stability.OVERLAP_EVERY_ROWS`)."""
+    extra: dict[str, Any] = {"overlap_every": OVERLAP_EVERY_ROWS * (plan.thermo_every or plan.dump_every)}
     rule = stop_rule(case, plan.steps * plan.time_step, plan.dump_every)
     if rule is not None:
         extra["stop"] = rule
     if case.run.crossings == "loop":
         extra["crossings"] = "loop"
-    if not extra:
-        return
     spec = json.loads(spec_path.read_text())
     spec.update(extra, particles=case.particle_count)
     spec_path.write_text(json.dumps(spec, indent=2))

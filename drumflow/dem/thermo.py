@@ -1,9 +1,12 @@
 """LIGGGHTS thermo output: live progress while running, and the time series afterwards.
 
-The deck's thermo style is ``step v_sim_time atoms ke c_ke_rot v_T_mean c_overlap_max cpu``; ``v_T_mean`` is
+The deck's thermo style is ``step v_sim_time atoms ke c_ke_rot v_T_mean v_overlap cpu``; ``v_T_mean`` is
 the mass-weighted mean particle temperature computed inside LIGGGHTS over all particles, at
-every output step. The series is rebuilt from LIGGGHTS' own log files (the first attempt and
-every resume), so an interrupted run loses nothing and ``drumflow post`` needs no solver.
+every output step. ``v_overlap`` is the largest particle-particle overlap, or
+:data:`OVERLAP_NOT_EVALUATED` on the rows where the coupling loop left it out
+(``overlap_every``); :func:`read_thermo` gives those rows NaN. The series is rebuilt from
+LIGGGHTS' own log files (the first attempt and every resume), so an interrupted run loses
+nothing and ``drumflow post`` needs no solver.
 """
 
 from __future__ import annotations
@@ -14,6 +17,8 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+
+from drumflow.coupling.spec import OVERLAP_NOT_EVALUATED
 
 COLUMNS = ("step", "time", "atoms", "ke", "ke_rot", "T_mean", "overlap_max", "cpu")
 #: Runs made before the overlap column existed (their logs stay readable by `drumflow post`).
@@ -120,4 +125,5 @@ def read_thermo(dem_dir: Path, every: int | None = None) -> pd.DataFrame:
         last = table["step"].max()
         table = table[(table["step"] % every == 0) | (table["step"] == last)]
     table["atoms"] = table["atoms"].astype(np.int64)
+    table.loc[table["overlap_max"] == OVERLAP_NOT_EVALUATED, "overlap_max"] = np.nan
     return table.drop(columns="attempt").reset_index(drop=True)

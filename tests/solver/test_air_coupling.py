@@ -61,6 +61,22 @@ def test_smoke_drum_with_uniform_air_cools_and_closes_energy(tmp_path: Path) -> 
     ranks = list((tmp_path / "run" / "dem" / "coupling").glob("rank1.*.csv"))
     assert ranks, "rank 1 wrote no coupling log: the run did not use 2 ranks"
     assert summary["particles_final"] == 500
+    # The loop evaluates the overlap column on every OVERLAP_EVERY_ROWS-th output row only (and
+    # the last): LIGGGHTS took the switched formula, the other rows read NaN.
+    from drumflow.dem.thermo import read_thermo
+
+    spec = json.loads((tmp_path / "run" / "dem" / "coupling.json").read_text())
+    thermo = read_thermo(tmp_path / "run" / "dem")
+    every = int(spec["overlap_every"])
+    on = thermo[thermo["step"] % every == 0]
+    # Rows of runs that end on a multiple, and of the last run, carry it too.
+    last_run = thermo["step"].max() - int(spec["interval"])
+    ends_on = (thermo["step"] // every + 1) * every - thermo["step"] < int(spec["interval"])
+    off = thermo[(thermo["step"] % every != 0) & (thermo["step"] < last_run) & ~ends_on]
+    assert len(on) >= 3 and len(off) >= 3 * len(on) // 2
+    # A bed: contacts overlap (at step 0 the particles are placed apart: LIGGGHTS' max of none).
+    assert (on.loc[on["step"] > 0, "overlap_max"] > 0.0).all()
+    assert off["overlap_max"].isna().all()
 
 
 @pytest.mark.timeout(600)

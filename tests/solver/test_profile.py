@@ -83,6 +83,7 @@ def _bench_from(run: Path, case_file: Path, out: Path, *extra: str) -> subproces
 
 def test_settings_study_from_the_restart(run: Path, tmp_path: Path) -> None:
     from drumflow.bench.settings import VARIANTS
+    from drumflow.dem.thermo import read_thermo
 
     study = tmp_path / "study"
     out = study / "settings.csv"
@@ -107,9 +108,19 @@ def test_settings_study_from_the_restart(run: Path, tmp_path: Path) -> None:
     deck = (out.parent / "variants" / "skin_x2" / "dem" / "in.drum.resume").read_text()
     base = (out.parent / "variants" / "baseline" / "dem" / "in.drum.resume").read_text()
     assert deck != base and "neighbor        0.008 bin" in deck
-    # The overlap compute is dropped from the thermo rows, their columns kept for the readers.
-    quiet = (out.parent / "variants" / "no_overlap" / "dem" / "in.drum.resume").read_text()
-    assert "c_overlap_max" in base and "c_overlap_max" not in quiet and "v_no_overlap" in quiet
+    # The overlap compute is dropped from the thermo rows, their columns kept for the readers;
+    # every row evaluates it in overlap_every_row (the loop does not switch it off there).
+    variants_dir = out.parent / "variants"
+    quiet = (variants_dir / "no_overlap" / "dem" / "in.drum.resume").read_text()
+    assert "variable overlap equal c_overlap_max" in base and "v_overlap" in base
+    assert "variable overlap equal -1" in quiet and "variable overlap equal c_overlap" not in quiet
+    specs = {name: json.loads((variants_dir / name / "dem" / "coupling.json").read_text())
+             for name in ("baseline", "no_overlap", "overlap_every_row")}
+    assert specs["baseline"]["overlap_every"] > 0
+    assert "overlap_every" not in specs["no_overlap"] and "overlap_every" not in specs["overlap_every_row"]
+    every_row = read_thermo(variants_dir / "overlap_every_row" / "dem")["overlap_max"]
+    never = read_thermo(variants_dir / "no_overlap" / "dem")["overlap_max"]
+    assert every_row.notna().all() and never.isna().all()
     # The conservative reference: half the step, the shell a rotating mesh, and the air clock
     # continuing from the restart's time (not step x the new step).
     folder = out.parent / "variants" / "conservative" / "dem"

@@ -150,3 +150,16 @@ def test_ranz_marshall_slip_inverts_the_correlation() -> None:
         assert v > 0.0
         assert float(ranz_marshall_h(v, d, air)) == pytest.approx(h, rel=1e-12)
     assert math.isnan(ranz_marshall_slip(0.99 * 2.0 * air.conductivity / 0.008, 0.008, air))
+
+
+def test_overlap_is_wanted_on_runs_reaching_a_multiple_and_the_last() -> None:
+    """The loop's overlap switch: a run of n steps from `step` evaluates the overlap column when
+    it ends on or passes a multiple of `every`, and on the run's last interval."""
+    from drumflow.coupling.driver import overlap_wanted
+
+    every, total = 420, 10_000
+    ends = [s + 42 for s in range(0, 2100, 42) if overlap_wanted(s, 42, every, total)]
+    assert ends == [420, 840, 1260, 1680, 2100]
+    assert overlap_wanted(9_990, 10, every, total)  # the last run
+    assert overlap_wanted(400, 100, every, total)  # passes 420 inside the run
+    assert not overlap_wanted(420, 42, every, total)  # starts on a multiple, ends off it

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 from drumflow.dem.thermo import read_thermo
@@ -42,3 +43,18 @@ def test_a_step_printed_twice_in_one_attempt_keeps_its_first_row(tmp_path: Path)
     table = read_thermo(tmp_path)
     assert table["step"].tolist() == [0, 10, 20]
     assert table["T_mean"].tolist() == [90.0, 89.0, 87.0]
+
+
+def test_rows_without_the_overlap_read_nan(tmp_path: Path) -> None:
+    """The coupling loop leaves the overlap column out of most rows (-1, `overlap_every`): those
+    read NaN, the evaluated rows their overlap."""
+    from drumflow.coupling.spec import OVERLAP_NOT_EVALUATED
+
+    header = "Step v_sim_time Atoms KinEng c_ke_rot v_T_mean v_overlap CPU \n"
+    overlaps = {0: 1e-4, 10: OVERLAP_NOT_EVALUATED, 20: 2e-4}
+    rows = "".join(f"{s} {s * 1e-3} 500 0.1 0.01 90.0 {o:g} 1.0 \n" for s, o in overlaps.items())
+    (tmp_path / "log.liggghts").write_text("LIGGGHTS (Version LIGGGHTS-PUBLIC 3.8.0)\n" + header
+                                           + rows + "Loop time of 1\n")
+    table = read_thermo(tmp_path)
+    assert table["overlap_max"].iloc[[0, 2]].tolist() == [1e-4, 2e-4]
+    assert math.isnan(table["overlap_max"].iloc[1])
