@@ -61,6 +61,18 @@ def test_series_marks_lost_particles_nan(tmp_path: Path) -> None:
     assert s.times.tolist() == [0.0, 0.01]
 
 
+def test_series_of_equal_counts_but_other_ids_keeps_the_union(tmp_path: Path) -> None:
+    """The shortcut for dumps with the same ids must not take two dumps of equal length whose
+    ids differ (one particle lost, another inserted)."""
+    _write(tmp_path, 0, [(1, 0, 0.1, 0, 0, 0, 0, 0.004, 90), (2, 0, 0.1, 0, 0, 0, 0, 0.004, 70)])
+    _write(tmp_path, 10, [(1, 0, 0.1, 0, 0, 0, 0, 0.004, 89), (3, 0, 0.1, 0, 0, 0, 0, 0.004, 60)])
+    _write(tmp_path, 20, [(1, 0, 0.1, 0, 0, 0, 0, 0.004, 88), (3, 0, 0.1, 0, 0, 0, 0, 0.004, 59)])
+    s = read_series(tmp_path, time_step=0.001)
+    assert s.ids.tolist() == [1, 2, 3]
+    assert s["T"][:, 0].tolist() == [90, 89, 88]
+    assert np.isnan(s["T"][1:, 1]).all() and np.isnan(s["T"][0, 2]) and s["T"][2, 2] == 59
+
+
 def test_crossings_of_free_fall() -> None:
     # 50 particles released from y = 0.1 at known times fall freely; each crosses y = 0 once
     # at t_release + sqrt(2 * 0.1 / g). Dumps every 2 ms: interpolation error is below
@@ -194,3 +206,20 @@ def test_a_newest_snapshot_cut_short_is_left_out_only_when_asked(tmp_path: Path)
         read_series(tmp_path, time_step=0.001)
     s = read_series(tmp_path, time_step=0.001, skip_partial_newest=True)
     assert s.steps.tolist() == [0] and [p.name for p in s.skipped] == ["snap.0000000010.txt"]
+
+
+def test_crossings_csv_is_the_pandas_text(tmp_path: Path) -> None:
+    """post/crossings.csv is written row by row for speed; its text is what pandas' to_csv with
+    %.6g gave (readers and shipped results unchanged)."""
+    import pandas as pd
+
+    from drumflow.pipeline import write_crossings_csv
+
+    rng = np.random.default_rng(3)
+    n = 1000
+    frame = pd.DataFrame({"time": rng.uniform(0, 17.5, n), "id": rng.integers(1, 467_443, n),
+                          "x": rng.uniform(-1.5, 1.5, n), "z": rng.uniform(0, 0.1, n)})
+    frame.loc[0, "x"], frame.loc[1, "z"], frame.loc[2, "time"] = 1e-7, -0.0, 123456789.0
+    write_crossings_csv(tmp_path / "a.csv", frame)
+    frame.to_csv(tmp_path / "b.csv", index=False, float_format="%.6g")
+    assert (tmp_path / "a.csv").read_text() == (tmp_path / "b.csv").read_text()
