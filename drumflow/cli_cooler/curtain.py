@@ -5,15 +5,16 @@ from __future__ import annotations
 import json
 import time
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import typer
 from rich.table import Table
 
 from drumflow.case import read_toml, validate_model
 from drumflow.cli_cooler._app import app, console, guard
-from drumflow.coolers._rundir import open_cooler_run, write_result
-from drumflow.coolers.curtain import CurtainCase, CurtainResult, solve_curtain
+
+if TYPE_CHECKING:
+    from drumflow.coolers.curtain import CurtainCase, CurtainResult
 
 
 def plot_curtain(case: CurtainCase, result: CurtainResult, path: Path) -> Path:
@@ -53,6 +54,10 @@ def curtain(
     force: Annotated[bool, typer.Option("--force", help="reuse a directory of another case")] = False,
 ) -> None:
     """Heat transfer in a particle curtain crossed by a gas stream (element-array model)."""
+    # Imported here so that other commands do not load the model (and scipy) at start-up.
+    from drumflow.coolers._rundir import open_cooler_run, write_result
+    from drumflow.coolers.curtain import CurtainCase, solve_curtain
+
     with guard():
         data = read_toml(case_file)
         case = validate_model(CurtainCase, data, case_file)

@@ -5,26 +5,17 @@ from __future__ import annotations
 import json
 import time
 from pathlib import Path
-from typing import Annotated, Any
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 from pydantic import BaseModel, ConfigDict
 from rich.table import Table
 
-from drumflow.analysis.closures import SliceClosures, extract_closures, load_closures
-from drumflow.analysis.predict import PAPER_PLANT, PlantSpec
 from drumflow.cli_cooler._app import app, console, err_console, guard
-from drumflow.coolers._rundir import open_cooler_run, write_result
-from drumflow.coolers._transport import calibrate
-from drumflow.coolers.drum import (
-    DrumModelError,
-    DrumOptions,
-    DrumResult,
-    extrapolation_warnings,
-    paper_exchanger,
-    solve_drum,
-    volumetric_coefficient_estimate,
-)
+
+if TYPE_CHECKING:
+    from drumflow.analysis.closures import SliceClosures
+    from drumflow.coolers.drum import DrumResult
 
 #: Table 7 of the paper, model one: its exchanger prediction of the plant.
 PAPER_TABLE7 = {"material_outlet_C": 40.90, "air_outlet_C": 69.73}
@@ -42,6 +33,8 @@ class DrumInputs(BaseModel):
 
 
 def _closures(source: Path) -> SliceClosures:
+    from drumflow.analysis.closures import extract_closures, load_closures
+
     if source.is_dir():
         return extract_closures(source)
     return load_closures(source)
@@ -111,6 +104,20 @@ def drum(
     force: Annotated[bool, typer.Option("--force", help="reuse a directory of another input")] = True,
 ) -> None:
     """Predict the paper's plant (3 m x 19 m NPK cooler) from slice closures; what-ifs by option."""
+    # The models import scipy; loading them here keeps `drumflow --help` and every other
+    # command from paying for it at start-up.
+    from drumflow.analysis.predict import PAPER_PLANT, PlantSpec
+    from drumflow.coolers._rundir import open_cooler_run, write_result
+    from drumflow.coolers._transport import calibrate
+    from drumflow.coolers.drum import (
+        DrumModelError,
+        DrumOptions,
+        extrapolation_warnings,
+        paper_exchanger,
+        solve_drum,
+        volumetric_coefficient_estimate,
+    )
+
     with guard():
         for name, value in (("--cells", cells), ("--rpm", rpm), ("--air-flow", air_flow),
                             ("--feed-rate", feed_rate), ("--particle-diameter", particle_diameter),
