@@ -114,7 +114,7 @@ class CouplingSpec:
             "coupling_log": COUPLING_LOG_PATTERN,
             "tail": tail,
             "coarse_grain": self.coarse_grain,
-            "heat_capacity": self.heat_capacity,
+            "heat_capacity": None,  # conduction on: LIGGGHTS integrates the temperatures
             **loop_heat,
         }
 

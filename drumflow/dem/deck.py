@@ -82,6 +82,12 @@ class StepPlan:
     def dump_interval(self) -> float:
         return self.dump_every * self.time_step
 
+    @property
+    def thermo_step(self) -> int:
+        """Steps between thermo rows (plans made before thermo_every existed print one per
+        output step)."""
+        return self.thermo_every or self.dump_every
+
 
 def plan_steps(case: Case, choice: TimeStepChoice) -> StepPlan:
     """Step counts for the run; output intervals are whole multiples of the output step."""
@@ -223,7 +229,7 @@ def deck_context(
         "period": f"{60.0 / case.drum.rpm:.9g}",
         "T0": p.initial_temperature_C,
         "temperature_spread": p.initial_temperature_spread_C,
-        "thermo_every": plan.thermo_every or plan.dump_every,
+        "thermo_every": plan.thermo_step,
         "dump_every": plan.dump_every,
         "snapshot_every": plan.snapshot_every,
         "cross_pattern": files.cross_pattern,

@@ -128,7 +128,7 @@ class DemResult:
 def _add_loop_options(spec_path: Path, case: Case, plan: StepPlan) -> None:
     """Give the coupling loop the 'converged' stop rule, the in-memory crossings and the rows
     the overlap bound is evaluated on (:data:`~drumflow.dem.stability.OVERLAP_EVERY_ROWS`)."""
-    extra: dict[str, Any] = {"overlap_every": OVERLAP_EVERY_ROWS * (plan.thermo_every or plan.dump_every)}
+    extra: dict[str, Any] = {"overlap_every": OVERLAP_EVERY_ROWS * plan.thermo_step}
     rule = stop_rule(case, plan.steps * plan.time_step, plan.dump_every)
     if rule is not None:
         extra["stop"] = rule
@@ -350,8 +350,7 @@ def _launch(case: Case, rundir: RunDir, runner: Runner, inputs: DemInputs, deck_
     else:
         spec_path = inputs.coupling.write_driver_file(work, deck_name, own_log.name,
                                                       inputs.plan.steps, inputs.plan.time_step,
-                                                      end_commands(context),
-                                                      inputs.plan.thermo_every or inputs.plan.dump_every)
+                                                      end_commands(context), inputs.plan.thermo_step)
         _add_loop_options(spec_path, case, inputs.plan)
         command = driver_command(runner.profile, inputs.processes, COUPLING_FILE)
     watcher = _RowWatcher(case, inputs, own_log, rundir.dem_restart, rundir.dem_dumps, resumed_from)
