@@ -170,6 +170,20 @@ def neighbor_skin(case: Case) -> float:
     return float(case.run.neighbor_skin)
 
 
+#: A resumed deck writes the turning mesh (the lifters, or the whole moving shell) once, at its
+#: set-up, as LIGGGHTS read it from the restart: drumflow.verify.resume checks its angle against
+#: the air's from this file, so the restart need not be kept for it. "*" is the step.
+RESUME_MESH_PATTERN = "mesh_at_resume.*.stl"
+
+
+def turning_mesh(files: DeckFiles) -> str:
+    """The LIGGGHTS mesh that turns with the drum: ``lifters`` (static shell), ``shell``
+    (moving-mesh shell with its lifters), or "" (a static shell without lifters: nothing turns)."""
+    if not files.static_shell:
+        return "shell"
+    return "lifters" if files.lifters_stl_file else ""
+
+
 def deck_context(
     case: Case,
     plan: StepPlan,
@@ -195,6 +209,8 @@ def deck_context(
         "soft_particles": min(p.youngs_modulus, E_wall) < SOFT_PARTICLE_LIMIT,
         "resume": resume_from is not None,
         "restart_file": resume_from or "",
+        "resume_mesh": turning_mesh(files) if resume_from is not None else "",
+        "resume_mesh_pattern": RESUME_MESH_PATTERN,
         "data_file": files.data_file,
         "skin": f"{neighbor_skin(case):.6g}",
         "E_particle": f"{p.youngs_modulus:.9g}",

@@ -23,6 +23,7 @@ from typing import TYPE_CHECKING, Any
 from drumflow.coupling.spec import COUPLING_FILE, CouplingSpec, driver_command
 from drumflow.coupling.stop import STOP_RECORD, stop_rule
 from drumflow.dem.deck import (
+    RESUME_MESH_PATTERN,
     DeckFiles,
     StepPlan,
     deck_context,
@@ -187,40 +188,38 @@ def latest_restart(folder: Path) -> tuple[Path, int] | None:
 #: Restart files kept in ``dem/restart`` while a run goes: the newest resumes the run; the one
 #: before it is a spare (one at the end, :func:`_tidy_output`). Older ones only take disk (170
 #: MB each for paper model two's 299,164 particles, 35 of them in a 17.5 s run), so they are
-#: removed as the run goes.
+#: removed as the run goes, the one an attempt resumed from too: what the resume check needs
+#: of it, the turning mesh as LIGGGHTS read it, the resumed deck writes at its set-up
+#: (:data:`~drumflow.dem.deck.RESUME_MESH_PATTERN`).
 KEEP_RESTARTS = 2
 #: How often (wall seconds) the run's thermo rows trigger the pruning.
 PRUNE_EVERY_S = 60.0
 
 
-def prune_restarts(folder: Path, keep: int = KEEP_RESTARTS, protect: Path | None = None) -> list[Path]:
+def prune_restarts(folder: Path, keep: int = KEEP_RESTARTS) -> list[Path]:
     """Remove all but the ``keep`` newest ``drum.STEP.restart`` files of ``folder``.
 
     Safe while LIGGGHTS runs: a file it is still writing is the newest, and the newest are
-    kept. Other files and ``protect`` (the restart this attempt resumed
-    from, which its deck names and the resume check reads) are not touched. Returns the removed
-    paths.
+    kept. Other files are not touched. Returns the removed paths.
     """
     steps = restart_files(folder)
-    removed = [p for _, p in steps[:max(0, len(steps) - keep)]
-               if protect is None or p.resolve() != protect.resolve()]
+    removed = [p for _, p in steps[:max(0, len(steps) - keep)]]
     for p in removed:
         p.unlink(missing_ok=True)
     return removed
 
 
-def _tidy_output(restarts: Path, dumps: Path, resumed_from: Path | None,
-                 finished: bool) -> None:
+def _tidy_output(restarts: Path, dumps: Path, finished: bool) -> None:
     """Prune restarts and pack snapshots. Housekeeping never stops a run: a file that cannot be
     packed (a snapshot cut short by an earlier kill) stays text, for ``drumflow post`` to name.
 
     While the run goes, the newest snapshot (perhaps still being written) stays text and the
     newest two restarts stay (the newest may be cut short by a kill). Once it has finished, its
-    last restart is complete: that one stays (the end state, to start a study or a longer run
-    from), with the one the attempt resumed from (the resume check re-reads it).
+    last restart is complete: only that one stays (the end state, to start a study or a longer
+    run from).
     """
     try:
-        prune_restarts(restarts, keep=1 if finished else KEEP_RESTARTS, protect=resumed_from)
+        prune_restarts(restarts, keep=1 if finished else KEEP_RESTARTS)
         pack_dumps(dumps, "snap", keep_newest=0 if finished else 1,
                    skip_unreadable=True)
     except OSError:
@@ -244,6 +243,7 @@ def _prepare_workdir(case: Case, rundir: RunDir, inputs: DemInputs, key: str) ->
         stale = [*rundir.dem_dumps.glob("*.txt"), *rundir.dem_dumps.glob("*.npz*"),
                  *rundir.dem_restart.glob("*.restart"),
                  *rundir.dem.glob("log.resume-*.liggghts"), *rundir.dem_coupling_logs.glob("*.csv"),
+                 *rundir.dem.glob(RESUME_MESH_PATTERN),
                  *rundir.dem_coupling_logs.glob("*.json")]
         for old in stale:
             old.unlink()
@@ -296,7 +296,7 @@ class _RowWatcher:
     run at the first row that breaks a physical bound."""
 
     def __init__(self, case: Case, inputs: DemInputs, own_log: Path, restarts: Path,
-                 dumps: Path, resumed_from: Path | None) -> None:
+                 dumps: Path) -> None:
         total = inputs.plan.steps * inputs.plan.time_step
         progress = inputs.progress
         self.parser = ThermoParser(
@@ -309,7 +309,6 @@ class _RowWatcher:
         self.command: list[str] = []
         self.restarts = restarts
         self.dumps = dumps
-        self.resumed_from = resumed_from
         self._pruned_at = time.monotonic()
 
     def __call__(self, line: str) -> None:
@@ -318,7 +317,7 @@ class _RowWatcher:
         if len(self.parser.rows) == before:
             return
         if time.monotonic() - self._pruned_at > PRUNE_EVERY_S:
-            _tidy_output(self.restarts, self.dumps, self.resumed_from, finished=False)
+            _tidy_output(self.restarts, self.dumps, finished=False)
             self._pruned_at = time.monotonic()
         row = self.parser.rows[-1]
         diagnosis = self.monitor.check(int(row[0]), row[1], int(row[2]), row[3], row[4], row[6])
@@ -333,11 +332,9 @@ class _RowWatcher:
 
 
 def _launch(case: Case, rundir: RunDir, runner: Runner, inputs: DemInputs, deck_name: str,
-            context: dict[str, Any], suffix: str,
-            resumed_from: Path | None) -> tuple[_RowWatcher, Path, float]:
+            context: dict[str, Any], suffix: str) -> tuple[_RowWatcher, Path, float]:
     """Run LIGGGHTS (or the coupling loop) with the stability monitor; return the watcher, the
-    standard-output log and the wall time. Restarts are pruned and snapshots packed as it goes;
-    ``resumed_from``, the restart this attempt started from, is kept."""
+    standard-output log and the wall time. Restarts are pruned and snapshots packed as it goes."""
     work = rundir.dem
     # LIGGGHTS writes (and flushes) its own log, which feeds the progress bar; the runner
     # keeps standard output separately.
@@ -353,7 +350,7 @@ def _launch(case: Case, rundir: RunDir, runner: Runner, inputs: DemInputs, deck_
                                                       end_commands(context), inputs.plan.thermo_step)
         _add_loop_options(spec_path, case, inputs.plan)
         command = driver_command(runner.profile, inputs.processes, COUPLING_FILE)
-    watcher = _RowWatcher(case, inputs, own_log, rundir.dem_restart, rundir.dem_dumps, resumed_from)
+    watcher = _RowWatcher(case, inputs, own_log, rundir.dem_restart, rundir.dem_dumps)
     watcher.command = command
     t0 = time.perf_counter()
     try:
@@ -375,7 +372,7 @@ def _launch(case: Case, rundir: RunDir, runner: Runner, inputs: DemInputs, deck_
     finally:
         rundir.record_commands([r.as_dict() for r in runner.records if r.program == "liggghts"][-1:])
     wall = time.perf_counter() - t0
-    _tidy_output(rundir.dem_restart, rundir.dem_dumps, resumed_from, finished=True)
+    _tidy_output(rundir.dem_restart, rundir.dem_dumps, finished=True)
     rundir.record("stability", watcher.record(stopped=False))
     return watcher, log, wall
 
@@ -401,8 +398,7 @@ def run(case: Case, rundir: RunDir, runner: Runner, inputs: DemInputs) -> DemRes
     resume = _prepare_workdir(case, rundir, inputs, key)
     deck_name, context = write_deck(case, rundir, inputs, resume)
     suffix = "" if resume is None else f".resume-{resume[1]}"
-    watcher, log, wall = _launch(case, rundir, runner, inputs, deck_name, context, suffix,
-                                 None if resume is None else resume[0])
+    watcher, log, wall = _launch(case, rundir, runner, inputs, deck_name, context, suffix)
     rows = watcher.parser.rows
     n = case.particle_count
     first_atoms = int(rows[0][2]) if rows else 0

@@ -8,11 +8,13 @@ the air would be sampled at the wrong angle, and if the mesh were re-read from i
 lifters would jump back to their initial angle. Either shows as a difference between the two
 angles below.
 
-:func:`lifter_angle_at_resume` measures the lifters' angle the way LIGGGHTS holds it: it re-runs
-the run's own resume deck (in a scratch copy, so the run directory is not touched) up to its
-set-up (``run 0``), dumps the lifter mesh, and finds the rotation that maps the geometry stage's
-STL onto it. The air angle is omega times the time of the first row of the resumed attempt's
-coupling log: the time the loop sampled the air at.
+:func:`lifter_angle_at_resume` measures the lifters' angle the way LIGGGHTS holds it: a resumed
+deck writes the turning mesh once at its set-up, as read from the restart
+(:data:`~drumflow.dem.deck.RESUME_MESH_PATTERN`), and the rotation that maps the geometry
+stage's STL onto it is the lifters' angle. The air angle is omega times the time of the first
+row of the resumed attempt's coupling log: the time the loop sampled the air at. (The check
+once re-ran the resume deck from the restart in a scratch copy; reading what the run itself
+wrote lets the run drop that restart, 0.27 GB for paper model one.)
 """
 
 from __future__ import annotations
@@ -20,19 +22,16 @@ from __future__ import annotations
 import json
 import math
 import re
-import shutil
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pandas as pd
 
-from drumflow.runner import Runner
+from drumflow.dem.deck import RESUME_MESH_PATTERN
 
-#: The resumed attempt's deck (drumflow.dem.stage) and the dump this module adds to a copy.
+#: The resumed attempt's deck (drumflow.dem.stage).
 RESUME_DECK = "in.drum.resume"
-#: LIGGGHTS asks for a "*" (one file per step); the step number replaces it.
-MESH_DUMP = "lifters_at_resume.*.stl"
 
 
 def read_stl_triangles(path: Path) -> np.ndarray:
@@ -69,17 +68,14 @@ def wrap_angle(angle: float, period: float) -> float:
     return -((-angle + 0.5 * period) % period - 0.5 * period)
 
 
-def lifter_angle_at_resume(run_dir: Path, work: Path, runner: Runner | None = None) -> dict[str, Any]:
+def lifter_angle_at_resume(run_dir: Path) -> dict[str, Any]:
     """The lifters' angle and the air-sampling angle at the start of a resumed attempt.
 
     Parameters
     ----------
     run_dir
-        A run directory whose DEM stage was resumed (it holds ``dem/in.drum.resume``) with air.
-    work
-        Scratch folder for the copy of the run's DEM and geometry folders (replaced).
-    runner
-        Runs LIGGGHTS (serial).
+        A run directory whose DEM stage was resumed with air: it holds ``dem/in.drum.resume``
+        and the turning mesh that deck wrote at its set-up.
 
     Returns
     -------
@@ -88,33 +84,26 @@ def lifter_angle_at_resume(run_dir: Path, work: Path, runner: Runner | None = No
         ``pitch_rad`` (2 pi / lifter count), ``lifter_angle_rad`` (measured from the mesh),
         ``air_angle_rad`` (omega t), both wrapped into one pitch, and ``mismatch_rad`` (their
         difference, wrapped the same way).
+
+    Raises
+    ------
+    ValueError
+        The deck does not resume from a numbered restart, or did not write the turning mesh
+        (a static shell without lifters, or a run resumed by an older drumflow).
     """
     from drumflow.case import load_case
 
-    runner = runner or Runner()
     case = load_case(run_dir / "case.toml")
     deck = (run_dir / "dem" / RESUME_DECK).read_text()
     m = re.search(r"^read_restart\s+restart/drum\.(\d+)\.restart", deck, flags=re.M)
     if m is None:
         raise ValueError(f"{run_dir}: {RESUME_DECK} does not read a numbered restart file")
     resume_step = int(m.group(1))
-    mesh = "lifters" if re.search(r"^fix lifters ", deck, flags=re.M) else "shell"
-    reference = "lifters.stl" if mesh == "lifters" else "walls.stl"
-
-    if work.exists():
-        shutil.rmtree(work)
-    shutil.copytree(run_dir / "geometry", work / "geometry")
-    shutil.copytree(run_dir / "dem", work / "dem",
-                    ignore=shutil.ignore_patterns("*.txt", "*.npz", "*.csv", "log*"))
-    # The resume deck with air ends at its set-up (`run 0`): the loop runs the steps. Dump the
-    # lifter mesh as LIGGGHTS holds it there (a dump writes at the set-up of a run).
-    if not re.fullmatch(r"run\s+0", deck.rstrip().splitlines()[-1].strip()):
-        raise ValueError(f"{run_dir}: {RESUME_DECK} is not a coupled deck ending at its set-up")
-    probe = deck + f"\ndump lifter_mesh all mesh/stl 1 {MESH_DUMP} {mesh}\nrun 0\n"
-    (work / "dem" / "in.angle").write_text(probe)
-    runner.run("liggghts", runner.profile.liggghts_command("in.angle", "log.angle", 1),
-               work / "dem", work / "dem" / "angle.out", timeout=300)
-    moved = read_stl_triangles(work / "dem" / MESH_DUMP.replace("*", str(resume_step)))
+    written = re.search(r"^dump\s+resume_mesh\s+all\s+mesh/stl\s+\d+\s+\S+\s+(\w+)", deck, flags=re.M)
+    if written is None:
+        raise ValueError(f"{run_dir}: {RESUME_DECK} writes no turning mesh to check")
+    reference = "lifters.stl" if written.group(1) == "lifters" else "walls.stl"
+    moved = read_stl_triangles(run_dir / "dem" / RESUME_MESH_PATTERN.replace("*", str(resume_step)))
     original = read_stl_triangles(run_dir / "geometry" / reference)
     n = max(case.lifters.count, 1)
     pitch = 2.0 * math.pi / n

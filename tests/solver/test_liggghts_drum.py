@@ -197,12 +197,13 @@ def test_interrupted_run_resumes(tmp_path: Path) -> None:
     snaps = read_series(out / "dem" / "dumps", dem["time_step"])
     spread = np.nanstd(snaps["T"], axis=1)
     assert np.all(np.diff(spread) < 1e-9) and spread[-1] < 0.98 * spread[0]
-    # 20 restarts were written (one per 0.1 s); once the run has finished, the end state is
-    # kept, numbered by the last step, and the one the resumed attempt started from (its deck
-    # names it, the resume check re-reads it); no separate final.restart (a third copy).
+    # 20 restarts were written (one per 0.1 s); once the run has finished, only the end state is
+    # kept, numbered by the last step: no separate final.restart (a second copy), and not the
+    # one the resumed attempt started from (the resume check reads the lifters that attempt
+    # wrote at its set-up, mesh_at_resume.STEP.stl, instead).
     kept = {p.name for p in (out / "dem" / "restart").iterdir()}
-    resumed = f"drum.{dem['resumed_from_step']}.restart"
-    assert kept == {resumed, f"drum.{dem['steps']}.restart"}, kept
+    assert kept == {f"drum.{dem['steps']}.restart"}, kept
+    assert (out / "dem" / f"mesh_at_resume.{dem['resumed_from_step']}.stl").is_file()
     # Every snapshot packed once LIGGGHTS finished.
     dumps = out / "dem" / "dumps"
     assert not list(dumps.glob("snap.*.txt")) and len(list(dumps.glob("snap.*.npz"))) == len(snaps.steps)
