@@ -1,0 +1,57 @@
+"""scripts/replicate_error.py on the shipped model-one run: a copy of it is its own replicate
+(every difference 0), a copy with its temperatures shifted shows the shift, and a run of
+another case is refused."""
+
+from __future__ import annotations
+
+import importlib.util
+import json
+import shutil
+from pathlib import Path
+from types import ModuleType
+
+import pandas as pd
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+SHIPPED = ROOT / "results" / "paper" / "model_one"
+PARCELS = ROOT / "results" / "paper_parcels" / "model_one"
+
+
+def _script() -> ModuleType:
+    spec = importlib.util.spec_from_file_location("replicate_error", ROOT / "scripts" / "replicate_error.py")
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_a_run_against_itself_and_against_a_shifted_copy(tmp_path: Path) -> None:
+    script = _script()
+    table, summary = script.compare(SHIPPED, SHIPPED, until=2.0, window=0.5)
+    assert summary["max_abs_temperature_difference_K"] == 0.0
+    assert summary["last_common_time_s"] == pytest.approx(2.0, abs=0.006)
+    assert list(table["window_end_s"]) == pytest.approx([0.5, 1.0, 1.5, 2.0], abs=0.006)
+    assert (table["falling_mass_flow_first_kg_s"] == table["falling_mass_flow_second_kg_s"]).all()
+    # The shipped run's first crossings were at 1.5 s: nothing falls before.
+    assert table["falling_mass_flow_first_kg_s"].iloc[:3].sum() == 0.0
+    assert table["falling_mass_flow_first_kg_s"].iloc[3] > 0.0
+
+    shifted = tmp_path / "shifted"
+    shutil.copytree(SHIPPED, shifted)
+    series = pd.read_csv(shifted / "post" / "mean_temperature.csv")
+    series["mean_temperature_C"] -= 0.25 * series["time_s"]  # cools 0.25 K/s faster
+    series.to_csv(shifted / "post" / "mean_temperature.csv", index=False)
+    out = tmp_path / "out"
+    assert script.main([str(SHIPPED), str(shifted), str(out), "--until", "2.0"]) == 0
+    summary = json.loads((out / "replicate.json").read_text())
+    end = summary["last_common_time_s"]
+    assert summary["temperature_difference_at_end_K"] == pytest.approx(-0.25 * end)
+    assert summary["cooling_second_K"] - summary["cooling_first_K"] == pytest.approx(0.25 * end)
+    assert len(pd.read_csv(out / "replicate.csv")) == 4
+
+
+def test_runs_of_different_cases_are_refused(tmp_path: Path) -> None:
+    # The parcel run differs in particles.coarse_grain: not a replicate.
+    assert _script().main([str(SHIPPED), str(PARCELS), str(tmp_path / "out")]) == 2
+    assert not (tmp_path / "out").exists()
