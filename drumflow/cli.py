@@ -139,6 +139,54 @@ def post(
     _print_summary(summary, run_dir, as_json)
 
 
+def _duration(seconds: float | None) -> str:
+    if seconds is None:
+        return "–"
+    hours, rest = divmod(int(round(seconds)), 3600)
+    return f"{hours}:{rest // 60:02d}:{rest % 60:02d}"
+
+
+@app.command()
+def status(
+    run_dir: Annotated[Path, typer.Argument(help="run directory written by `drumflow run`")],
+    as_json: Annotated[bool, typer.Option("--json", help="print the status as JSON")] = False,
+) -> None:
+    """Where a run stands (running, interrupted or finished): time reached, pace, ETA, disk."""
+    from drumflow.analysis.run_status import RECENT_UPDATES, run_status
+
+    st = run_status(run_dir)
+    if as_json:
+        console.print_json(json.dumps(st.to_dict()))
+        return
+    table = Table(title=f"{st.case} → {run_dir}", show_header=False)
+    if st.finished:
+        state = "finished"
+    elif st.log_age_s is not None and st.log_age_s < 300:
+        state = f"running (log written {st.log_age_s:.0f} s ago)"
+    elif st.reached_time_s is not None:
+        state = f"stopped: run `drumflow run` again to resume (log idle for {_duration(st.log_age_s)})"
+    else:
+        state = f"DEM not started (stages done: {', '.join(st.stages_done) or 'none'})"
+    table.add_row("state", state)
+    if st.reached_time_s is not None:
+        share = st.reached_time_s / st.target_time_s if st.target_time_s else 0.0
+        table.add_row("simulated", f"{st.reached_time_s:.3f} of {st.target_time_s:g} s ({share:.1%}), "
+                      f"step {st.step:,}")
+        table.add_row("particles", f"{st.particles:,} of {st.particles_initial:,}")
+    if st.wall_per_simulated_s is not None:
+        table.add_row("pace (last updates)", f"{st.wall_per_simulated_s:,.0f} wall s per simulated s "
+                      f"(last {RECENT_UPDATES} air updates)")
+    if st.eta_s is not None:
+        table.add_row("to the end at that pace", _duration(st.eta_s))
+    if st.restart_step is not None:
+        table.add_row("a resume starts from", f"restart of step {st.restart_step:,} "
+                      f"({st.restart_time_s:.3f} s)" if st.restart_time_s is not None
+                      else f"restart of step {st.restart_step:,}")
+    table.add_row("disk", f"{st.output_bytes / 1e9:.2f} GB output, {st.restart_bytes / 1e9:.2f} GB in "
+                  f"{st.restarts} restart file(s)")
+    console.print(table)
+
+
 def _exchanger_rows(table: Table, r, label_suffix: str = "") -> None:  # type: ignore[no-untyped-def]
     rows = [
         ("material inlet T_mi (°C)", f"{r.material_inlet_temperature_c:.2f}"),

@@ -38,6 +38,7 @@ import pytest
 from scipy.optimize import curve_fit
 from support.solvers import LIGGGHTS, OPENFOAM, requires_solver
 
+from drumflow.analysis.run_status import run_status
 from drumflow.case import Case
 from drumflow.pipeline import run_case
 from drumflow.runner import StopRun
@@ -135,6 +136,12 @@ def test_resume_continues_the_clock_and_the_lifter_angle(runs: dict[str, Path]) 
     # mesh the resumed deck wrote instead; the finished run keeps only its last restart.
     kept = sorted(p.name for p in (runs["resumed"] / "dem" / "restart").glob("drum.*.restart"))
     assert kept == [f"drum.{dem['steps']}.restart"], kept
+    # `drumflow status` reads the same from the finished run's files.
+    st = run_status(runs["resumed"])
+    assert st.finished and st.eta_s is None and st.restarts == 1 and st.restart_step == dem["steps"]
+    assert st.step == dem["steps"] and st.particles == st.particles_initial
+    assert st.reached_time_s == pytest.approx(dem["steps"] * dem["time_step"], rel=1e-9)
+    assert st.wall_per_simulated_s is not None and st.wall_per_simulated_s > 0
 
 
 def test_resumed_run_matches_the_uninterrupted_one(runs: dict[str, Path]) -> None:

@@ -1,0 +1,177 @@
+"""Where a run stands, read from its directory while it goes or after: ``drumflow status``.
+
+A paper-scale run takes hours in the background (model one with every particle: about 15 h on
+2 cores), and its progress bar is in a log file. This reads what the run writes anyway (the
+manifest, the stage markers, LIGGGHTS' own log, the coupling loop's per-update wall times and
+the restart files) and says how far it has got, how fast it goes now and when it will end at
+that pace, what a resume would start from, and how much disk it holds. No solver is started
+and nothing is written.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import time
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Any
+
+from drumflow.coupling.log import read_coupling, update_walls
+from drumflow.dem.stage import restart_files
+from drumflow.dem.thermo import COLUMNS, ThermoParser, log_files
+from drumflow.errors import MissingRunFileError
+
+#: Updates the recent pace is taken over: about two minutes of model one, long enough to even
+#: out a slow update, short enough to follow the fall in pace as the curtain forms.
+RECENT_UPDATES = 20
+#: Bytes read from the end of the newest LIGGGHTS log for its last thermo row.
+LOG_TAIL_BYTES = 65536
+
+
+@dataclass(frozen=True)
+class RunStatus:
+    """A run directory's state. Times in seconds; ``None`` where the run has not written it.
+
+    Attributes
+    ----------
+    case, target_time_s
+        The case's name and its ``run.time``.
+    stages_done
+        Stages with a finished marker, in pipeline order.
+    finished
+        The DEM stage has finished (the run reached its end or its stop rule fired).
+    reached_time_s, step, particles
+        The last thermo row LIGGGHTS wrote: simulated time, step, particles in the domain.
+    particles_initial
+        The case's particle count (spheres, after coarse-graining).
+    log_age_s
+        Wall seconds since the newest LIGGGHTS log was written (a running run writes every
+        few seconds).
+    wall_per_simulated_s
+        Wall seconds per simulated second over the last :data:`RECENT_UPDATES` coupling updates
+        that logged a time (runs with air).
+    eta_s
+        Wall seconds to ``target_time_s`` at that pace (a lower bound when the pace falls, as
+        it does while a curtain forms).
+    restart_step, restart_time_s
+        The newest restart file, which a resume starts from.
+    restarts, restart_bytes
+        Restart files kept and their size.
+    output_bytes
+        Everything else in the run directory.
+    """
+
+    run_dir: str
+    case: str
+    target_time_s: float
+    stages_done: list[str]
+    finished: bool
+    reached_time_s: float | None
+    step: int | None
+    particles: int | None
+    particles_initial: int
+    log_age_s: float | None
+    wall_per_simulated_s: float | None
+    eta_s: float | None
+    restart_step: int | None
+    restart_time_s: float | None
+    restarts: int
+    restart_bytes: int
+    output_bytes: int
+
+    def to_dict(self) -> dict[str, Any]:
+        return asdict(self)
+
+
+STAGE_ORDER = ("geometry", "air", "dem", "post")
+
+
+def _last_thermo_row(log: Path) -> tuple[float, ...] | None:
+    with log.open("rb") as fh:
+        fh.seek(max(0, log.stat().st_size - LOG_TAIL_BYTES))
+        tail = fh.read().decode(errors="replace")
+    parser = ThermoParser(columns=COLUMNS)
+    for line in tail.splitlines():
+        parser(line)
+    return parser.rows[-1] if parser.rows else None
+
+
+def _recent_pace(coupling_dir: Path, time_step: float) -> float | None:
+    if not coupling_dir.is_dir():
+        return None
+    coupling = read_coupling(coupling_dir, time_step)
+    if coupling.empty:
+        return None
+    updates = update_walls(coupling)
+    updates = updates[~updates["paused"].astype(bool)].tail(RECENT_UPDATES)
+    simulated = float((updates["steps"] * time_step).sum())
+    return float(updates["wall_s"].sum()) / simulated if simulated > 0 else None
+
+
+def run_status(run_dir: Path | str, now: float | None = None) -> RunStatus:
+    """Read a run directory's state (see :class:`RunStatus`).
+
+    Parameters
+    ----------
+    run_dir
+        A directory made by ``drumflow run`` (finished, running or interrupted).
+    now
+        The wall clock to measure the log's age against (default: now).
+
+    Raises
+    ------
+    MissingRunFileError
+        ``run_dir`` has no ``manifest.json``: not a run directory, or one whose run has not
+        started.
+    """
+    from drumflow.case import load_case
+
+    root = Path(run_dir)
+    manifest_path = root / "manifest.json"
+    if not manifest_path.is_file():
+        raise MissingRunFileError(manifest_path.resolve(), "the run's manifest")
+    manifest = json.loads(manifest_path.read_text())
+    case = load_case(root / "case.toml")
+    stages = {p.stem for p in (root / "stages").glob("*.json")}
+    done = [s for s in STAGE_ORDER if s in stages] + sorted(stages - set(STAGE_ORDER))
+    time_step = (manifest.get("time_step") or {}).get("time_step")
+
+    dem = root / "dem"
+    logs = log_files(dem) if dem.is_dir() else []
+    row = _last_thermo_row(logs[-1]) if logs else None
+    age = None
+    if logs:
+        age = (time.time() if now is None else now) - max(p.stat().st_mtime for p in logs)
+
+    pace = _recent_pace(dem / "coupling", float(time_step)) if time_step else None
+    reached = row[1] if row is not None else None
+    finished = "dem" in stages
+    eta = None
+    if pace is not None and reached is not None and not finished:
+        eta = max(0.0, case.run.time - reached) * pace
+
+    restarts = restart_files(dem / "restart") if (dem / "restart").is_dir() else []
+    restart_bytes = sum(p.stat().st_size for _, p in restarts)
+    total = sum(p.stat().st_size for p in root.rglob("*") if p.is_file())
+    newest = restarts[-1][0] if restarts else None
+    return RunStatus(
+        run_dir=str(root),
+        case=case.name,
+        target_time_s=case.run.time,
+        stages_done=done,
+        finished=finished,
+        reached_time_s=reached,
+        step=None if row is None else int(row[0]),
+        particles=None if row is None else int(row[2]),
+        particles_initial=case.dem_case().particle_count,
+        log_age_s=age,
+        wall_per_simulated_s=pace,
+        eta_s=eta,
+        restart_step=newest,
+        restart_time_s=(newest * float(time_step)
+                        if newest is not None and time_step and math.isfinite(float(time_step)) else None),
+        restarts=len(restarts),
+        restart_bytes=restart_bytes,
+        output_bytes=total - restart_bytes,
+    )

@@ -1,0 +1,96 @@
+"""`drumflow status`: a run directory's state from the files a run writes (no solver).
+
+The directory here is written by hand in the layout `drumflow run` leaves (manifest, stage
+markers, LIGGGHTS logs, the coupling loop's per-update log, restart files), so every number
+the status reports is known. The solver side (a finished coupled run) is in
+tests/solver/test_coupled_resume_and_report.py.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from drumflow.analysis.run_status import LOG_TAIL_BYTES, RECENT_UPDATES, run_status
+from drumflow.case import case_to_toml, load_case
+from drumflow.cli import app
+from drumflow.errors import MissingRunFileError
+
+ROOT = Path(__file__).resolve().parents[2]
+DT = 1e-4
+STEPS_PER_UPDATE = 50
+
+
+def _thermo(step: int, atoms: int = 3000) -> str:
+    return f"{step} {step * DT:.12g} {atoms} 1.5 0.1 85.0 -1 3.2\n"
+
+
+def _write_run(root: Path, *, last_step: int, update_walls: list[float]) -> Path:
+    case = load_case(ROOT / "cases" / "smoke.toml")
+    (root / "stages").mkdir(parents=True)
+    (root / "case.toml").write_text(case_to_toml(case))
+    (root / "manifest.json").write_text(json.dumps({"time_step": {"time_step": DT}}))
+    (root / "stages" / "geometry.json").write_text("{}")
+    dem = root / "dem"
+    (dem / "coupling").mkdir(parents=True)
+    (dem / "restart").mkdir()
+    # The first attempt's log, then a resumed one whose last row is far from its start: longer
+    # than the tail that is read, so only the end of the file is parsed.
+    (dem / "log.liggghts").write_text("".join(_thermo(s) for s in range(0, 1000, 100)))
+    filler = "Loop time of 1.0 on 2 procs for 50 steps with 3000 atoms\n" * (LOG_TAIL_BYTES // 40)
+    (dem / "log.resume-1000.liggghts").write_text(
+        _thermo(1000) + filler + _thermo(last_step - 100) + _thermo(last_step, atoms=2999))
+    rows = ["step,time_s,steps,heat_to_particles_W,drag_x_N,drag_y_N,drag_z_N,particles,"
+            "mean_slip_m_s,python_wall_s,liggghts_wall_s"]
+    for i, wall in enumerate(update_walls):
+        step = 1000 + i * STEPS_PER_UPDATE
+        rows.append(f"{step},{step * DT},{STEPS_PER_UPDATE},-10.0,0,0,0,3000,1.0,0.0,{wall}")
+    (dem / "coupling" / "rank0.1000.csv").write_text("\n".join(rows) + "\n")
+    (dem / "restart" / "drum.1000.restart").write_bytes(b"r" * 700)
+    (dem / "restart" / "drum.2000.restart").write_bytes(b"r" * 300)
+    return root
+
+
+def test_a_running_run(tmp_path: Path) -> None:
+    # 30 updates: the first ten slow (the pace has changed since), the last 20 at 2 s per
+    # 50 steps of 1e-4 s, i.e. 400 wall s per simulated s.
+    walls = [9.0] * 10 + [2.0] * RECENT_UPDATES
+    run = _write_run(tmp_path / "run", last_step=2500, update_walls=walls)
+    st = run_status(run, now=(run / "dem" / "log.resume-1000.liggghts").stat().st_mtime + 12.0)
+    assert st.case == "smoke" and st.target_time_s == 3.0
+    assert st.stages_done == ["geometry"] and not st.finished
+    assert st.step == 2500 and st.reached_time_s == pytest.approx(0.25)
+    assert st.particles == 2999 and st.particles_initial == 3000
+    assert st.log_age_s == pytest.approx(12.0)
+    assert st.wall_per_simulated_s == pytest.approx(2.0 / (STEPS_PER_UPDATE * DT))
+    assert st.eta_s == pytest.approx((3.0 - 0.25) * 400.0)
+    assert st.restart_step == 2000 and st.restart_time_s == pytest.approx(0.2)
+    assert st.restarts == 2 and st.restart_bytes == 1000
+    total = sum(p.stat().st_size for p in run.rglob("*") if p.is_file())
+    assert st.output_bytes == total - 1000
+
+
+def test_a_finished_run_has_no_eta_and_the_cli_prints_it(tmp_path: Path) -> None:
+    run = _write_run(tmp_path / "run", last_step=30000, update_walls=[2.0] * 5)
+    (run / "stages" / "dem.json").write_text("{}")
+    old = (run / "dem" / "log.resume-1000.liggghts").stat().st_mtime - 7200
+    for log in (run / "dem").glob("log*"):
+        os.utime(log, (old, old))
+    st = run_status(run)
+    assert st.finished and st.eta_s is None and st.stages_done == ["geometry", "dem"]
+    result = CliRunner().invoke(app, ["status", str(run)])
+    assert result.exit_code == 0, result.output
+    assert "finished" in result.output and "3.000 of 3 s" in result.output
+    data = json.loads(CliRunner().invoke(app, ["status", str(run), "--json"]).output)
+    assert data["reached_time_s"] == pytest.approx(3.0) and data["restarts"] == 2
+
+
+def test_not_a_run_directory(tmp_path: Path) -> None:
+    with pytest.raises(MissingRunFileError, match="manifest"):
+        run_status(tmp_path)
+    result = CliRunner().invoke(app, ["status", str(tmp_path)])
+    assert result.exit_code == 2 and "manifest" in result.output
