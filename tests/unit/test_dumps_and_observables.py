@@ -171,6 +171,46 @@ def test_packed_snapshot_reads_back_what_the_text_held(tmp_path: Path) -> None:
     assert np.array_equal(series["T"], series_text["T"])
 
 
+def test_what_does_not_vary_is_packed_once(tmp_path: Path) -> None:
+    """One radius for every particle and ids 1..N are kept as one value each; ids with a gap (a
+    particle lost) and varying columns in full; both read back as they were."""
+    from drumflow.dem.dumps import pack_dump
+
+    n = 400
+    rng = np.random.default_rng(5)
+    xyz = np.round(rng.uniform(-1.0, 1.0, (n, 3)), 7)
+    whole = [(i + 1, *xyz[i], 0.0, 0.0, 0.0, 0.004, 90.0) for i in range(n)]
+    gap = [r for r in whole if r[0] != 17]
+    _write(tmp_path, 0, whole)
+    _write(tmp_path, 10, gap)
+    before = {s: read_dump(tmp_path / f"snap.{s:010d}.txt") for s in (0, 10)}
+    packed = {s: pack_dump(tmp_path / f"snap.{s:010d}.txt") for s in (0, 10)}
+    with np.load(packed[0]) as data:
+        assert data["c_radius"].shape == (1,) and data["c_T"].shape == (1,) and "c_id" not in data
+        assert data["c_x"].shape == (n,)
+    with np.load(packed[10]) as data:
+        assert data["c_id"].shape == (n - 1,) and data["c_radius"].shape == (1,)
+    for s, path in packed.items():
+        after = read_dump(path)
+        assert np.array_equal(after.ids, before[s].ids) and len(after) == len(before[s])
+        for c in ("radius", "T", "vx"):
+            assert np.array_equal(after.columns[c], before[s].columns[c].astype(np.float32))
+    # 400 ids (int32) and radii (float32) are 3.2 kB less than in full.
+    assert packed[0].stat().st_size < packed[10].stat().st_size - 1500
+
+
+def test_snapshots_packed_before_the_elision_still_read(tmp_path: Path) -> None:
+    # Regression guard: runs packed by earlier drumflow (shipped, or a long run resumed on new
+    # code) keep their files; those have every column in full and no row count.
+    old = tmp_path / "snap.0000000020.npz"
+    np.savez(old, step=np.array(20), names=np.array(["id", "x", "radius"]),
+             c_id=np.array([1, 2, 3], dtype=np.int32), c_x=np.array([0.1, 0.2, 0.3], dtype=np.float32),
+             c_radius=np.array([0.004] * 3, dtype=np.float32))
+    snap = read_dump(old)
+    assert snap.step == 20 and snap.ids.tolist() == [1, 2, 3]
+    assert snap.columns["radius"].tolist() == pytest.approx([0.004] * 3)
+
+
 def test_a_partial_pack_is_ignored_and_a_bad_one_named(tmp_path: Path) -> None:
     from drumflow.dem.dumps import dump_files
 
