@@ -19,6 +19,10 @@ A rung is a finished (or still going) run directory, or a shipped results folder
 * ``rule``: the first firing of ``run.stop = "converged"`` replayed on the run's own series (the
   rule a user can switch on); a rule that never fires runs to the end.
 
+A rung may set ``until``: its run is replayed as if it had ended there (the last output at or
+before it), for a ladder over a window shorter than some of its runs, e.g. paper model one,
+whose full-particle run has only its first 3.5 s, against a parcel run to 17.5 s.
+
 The reference rung's answer at its end gives the errors of every rung. Its batch-means
 half-widths are the noise floor: an error below it is chaos, not a setting. Wall times are the
 replay's (coupling updates, no set-up or air solve), times ``wall_scale`` when a rung's run is a
@@ -91,6 +95,8 @@ class RungSpec(BaseModel):
                                                    "when it is not 1)")
     rate: float | None = Field(None, gt=0.0, description="particle-steps per wall second for "
                                                          "updates without logged wall times")
+    until: float | None = Field(None, gt=0.0, description="replay the run as if it had ended "
+                                                          "here, s (its last output at or before)")
 
     @model_validator(mode="after")
     def _scale_has_a_source(self) -> RungSpec:
@@ -254,6 +260,31 @@ def _stop(rung: RungSpec, replay: AnswerReplay, spec: LadderSpec,
     return end, values, note
 
 
+def _grid_until(run: Path, until: float) -> list[float]:
+    """The replay's regular end times (every 0.1 s from ``run.mass_flow_start``) below ``until``,
+    and ``until``."""
+    from drumflow.bench.answer import DEFAULT_CHECK_INTERVAL_S
+    from drumflow.case import load_case
+
+    start = float(load_case(run / "case.toml").run.mass_flow_start)
+    n = int(math.floor((until - start) / DEFAULT_CHECK_INTERVAL_S - 1e-9))
+    return [start + DEFAULT_CHECK_INTERVAL_S * k for k in range(1, n + 1)] + [until]
+
+
+def _cut(replay: AnswerReplay, until: float) -> AnswerReplay:
+    """``replay`` as if its run had ended at ``until``: the rows after it dropped, and a rule
+    firing after it not seen."""
+    from dataclasses import replace
+
+    table = replay.table[replay.table["time_s"] <= until + _TIME_EPS_S].reset_index(drop=True)
+    end = float(table["time_s"].iloc[-1])
+    if replay.first_fire_s is not None and replay.first_fire_s <= end + _TIME_EPS_S:
+        return replace(replay, table=table, reference_time_s=end)
+    return replace(replay, table=table, reference_time_s=end, first_fire_s=None,
+                   first_fire_grid_s=None, at_first_fire={},
+                   first_fire_reason=f"did not fire by {end:.4g} s (the rung's until)")
+
+
 def answer_ladder(spec: LadderSpec) -> AnswerLadder:
     """Replay every rung's run and set each stop's wall time and errors against the reference.
 
@@ -262,14 +293,16 @@ def answer_ladder(spec: LadderSpec) -> AnswerLadder:
     AnalysisInputError, MissingRunFileError, RunTooShortError
         A rung's run cannot be replayed (from :func:`~drumflow.bench.answer.replay_answer`).
     """
-    replays: dict[tuple[Path, float | None], AnswerReplay] = {}
+    replays: dict[tuple[Path, float | None, float | None], AnswerReplay] = {}
 
     def replay_of(rung: RungSpec) -> AnswerReplay:
-        key = (rung.run, rung.rate)
+        key = (rung.run, rung.rate, rung.until)
         if key not in replays:
-            replays[key] = replay_answer(rung.run, tolerance=spec.tolerance,
-                                         settle_tolerance=spec.tolerance,
-                                         particle_steps_per_s=rung.rate)
+            times = None if rung.until is None else _grid_until(rung.run, rung.until)
+            replay = replay_answer(rung.run, tolerance=spec.tolerance,
+                                   settle_tolerance=spec.tolerance,
+                                   particle_steps_per_s=rung.rate, times=times)
+            replays[key] = replay if rung.until is None else _cut(replay, rung.until)
         return replays[key]
 
     ref_rung = next(r for r in spec.rungs if r.name == spec.reference)

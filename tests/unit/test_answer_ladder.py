@@ -171,3 +171,55 @@ def test_estimated_share_between_grid_times() -> None:
     assert estimated_share(table, 1.15) == 0.5
     assert estimated_share(table, 1.2) == 0.4
     assert estimated_share(table, 0.5) == 1.0
+
+
+def test_until_replays_a_run_as_if_it_had_ended_there(folder: Path, tmp_path: Path) -> None:
+    """A window shorter than the run: the rung's end, values and errors are those of the run cut
+    at `until` (what `replay_answer` reports for that end time), the reference too."""
+    until = round(0.6 * RUN_TIME, 3)
+    spec = tmp_path / "window.toml"
+    spec.write_text(f'''
+title = "a window"
+reference = "short"
+answers = ["temperature", "h"]
+
+[[rungs]]
+name = "short"
+description = "the run cut at until"
+run = "{folder / 'a'}"
+until = {until}
+
+[[rungs]]
+name = "whole"
+description = "the same run to its end"
+run = "{folder / 'a'}"
+
+[[rungs]]
+name = "short_rule"
+description = "the rule, cut at until"
+run = "{folder / 'a'}"
+until = {until}
+stop = "rule"
+''')
+    ladder = answer_ladder(load_ladder_spec(spec))
+    rows = ladder.table.set_index("rung")
+    cut = replay_answer(folder / "a", times=[until])
+    end = float(cut.table["time_s"].iloc[0])  # the last output at or before `until`
+    assert end <= until + 1e-9 and end > until - 0.05
+    assert rows.loc["short", "stop_time_s"] == pytest.approx(end)
+    assert rows.loc["short", "run_end_s"] == pytest.approx(end)
+    assert ladder.reference_values["h"] == pytest.approx(float(cut.table["h_W_m2K"].iloc[0]))
+    assert rows.loc["short", "max_error"] == pytest.approx(0.0, abs=1e-12)
+    # The whole run differs from its first 60 % by what h drifts after `until`.
+    whole_h = float(replay_answer(folder / "a").reference["h_W_m2K"])
+    assert rows.loc["whole", "error_h"] == pytest.approx(whole_h / ladder.reference_values["h"] - 1.0)
+    # The rule cannot fire in a window ending before its minimum time: it runs to `until`.
+    assert rows.loc["short_rule", "stop_time_s"] <= until + 1e-9
+    bad = spec.read_text().replace(f"until = {until}\n", "until = -1\n", 1)
+    with pytest.raises(CaseError, match="until"):
+        load_ladder_spec(_write(tmp_path / "bad.toml", bad))
+
+
+def _write(path: Path, text: str) -> Path:
+    path.write_text(text)
+    return path
