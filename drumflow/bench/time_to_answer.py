@@ -364,7 +364,7 @@ def plot_ladder(ladder: AnswerLadder, path: Path) -> None:
 
 
 def _draw_ladder(ax: Axes, table: pd.DataFrame, tolerance: float, floor: float) -> None:
-    from matplotlib.ticker import ScalarFormatter
+    from matplotlib.ticker import NullFormatter, ScalarFormatter
 
     shown = table[np.isfinite(table["wall_s"]) & np.isfinite(table["max_error"])]
     labels: dict[tuple[float, float], list[str]] = {}
@@ -383,7 +383,10 @@ def _draw_ladder(ax: Axes, table: pd.DataFrame, tolerance: float, floor: float) 
                label=f"noise floor {floor:.2%} (reference's batch means)")
     ax.set_xscale("log")
     ax.xaxis.set_major_formatter(ScalarFormatter())
-    ax.xaxis.set_minor_formatter(ScalarFormatter())
+    # Minor ticks are labelled only within a decade: over more they run into each other
+    # (model one's ladder spans 0.1-8 h).
+    lo, hi = ax.get_xlim()
+    ax.xaxis.set_minor_formatter(ScalarFormatter() if hi / lo <= 10.0 else NullFormatter())
     ax.set_xlabel("wall time to the answer, h (squares: estimated)")
     ax.set_ylabel("largest answer error against the reference, %")
     ax.grid(True, which="both", alpha=0.3)
