@@ -450,13 +450,19 @@ def replay_answer(
     )
 
 
+def regular_end_times(start: float, end: float,
+                      every: float = DEFAULT_CHECK_INTERVAL_S) -> NDArray[np.float64]:
+    """The replay's regular grid of end times: every ``every`` s after ``start``, up to ``end``."""
+    n = int(math.floor((end - start) / every + 1e-9))
+    return start + every * np.arange(1, n + 1, dtype=np.float64)
+
+
 def _grid(out_t: NDArray[np.float64], start: float, every: float,
           times: Sequence[float] | None) -> NDArray[np.float64]:
     """End times, snapped to the last output time at or before each; the run's end last."""
     end = float(out_t[-1])
     if times is None:
-        n = int(math.floor((end - start) / every + 1e-9))
-        targets = start + every * np.arange(1, n + 1)
+        targets = regular_end_times(start, end, every)
     else:
         targets = np.asarray(list(times), dtype=float)
         bad = targets[~np.isfinite(targets) | (targets <= start) | (targets > end + _TIME_EPS_S)]

@@ -47,7 +47,13 @@ from numpy.typing import NDArray
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
 from drumflow._json import json_safe
-from drumflow.bench.answer import DEFAULT_TOLERANCE, AnswerReplay, replay_answer, settled_time
+from drumflow.bench.answer import (
+    DEFAULT_TOLERANCE,
+    AnswerReplay,
+    regular_end_times,
+    replay_answer,
+    settled_time,
+)
 from drumflow.errors import CaseError
 
 if TYPE_CHECKING:
@@ -261,14 +267,11 @@ def _stop(rung: RungSpec, replay: AnswerReplay, spec: LadderSpec,
 
 
 def _grid_until(run: Path, until: float) -> list[float]:
-    """The replay's regular end times (every 0.1 s from ``run.mass_flow_start``) below ``until``,
-    and ``until``."""
-    from drumflow.bench.answer import DEFAULT_CHECK_INTERVAL_S
+    """The replay's regular end times up to ``until``, and ``until``."""
     from drumflow.case import load_case
 
     start = float(load_case(run / "case.toml").run.mass_flow_start)
-    n = int(math.floor((until - start) / DEFAULT_CHECK_INTERVAL_S - 1e-9))
-    return [start + DEFAULT_CHECK_INTERVAL_S * k for k in range(1, n + 1)] + [until]
+    return [*regular_end_times(start, until), until]
 
 
 def _cut(replay: AnswerReplay, until: float) -> AnswerReplay:
