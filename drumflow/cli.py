@@ -75,6 +75,19 @@ def check(case_file: Annotated[Path, typer.Argument(help="case file (TOML)")]) -
     console.print(table)
 
 
+def _resume_point(out: Path) -> str:
+    """Where a resume of the run in ``out`` starts, for the interrupt message ('' if unknown)."""
+    from drumflow.analysis.run_status import run_status
+
+    try:
+        status = run_status(out)
+    except Exception:  # an interrupt before the run directory was complete: say nothing more
+        return ""
+    if status.restart_time_s is None:
+        return " (no restart yet: it starts again from 0 s)"
+    return f" (from its restart at {status.restart_time_s:.4g} s, step {status.restart_step:,})"
+
+
 @app.command()
 def run(
     case_file: Annotated[Path, typer.Argument(help="case file (TOML)")],
@@ -97,7 +110,7 @@ def run(
             summary = run_case(case, out, processes=np_, steps=steps, timeout=timeout,
                                progress=progress, force=force)
     except KeyboardInterrupt:
-        err_console.print(f"run the same command again to resume into {out}")
+        err_console.print(f"run the same command again to resume into {out}{_resume_point(out)}")
         raise
     _print_summary(summary, out, as_json)
     if summary.get("status", "ok") != "ok":
@@ -161,10 +174,12 @@ def status(
     table = Table(title=f"{st.case} → {run_dir}", show_header=False)
     if st.finished:
         state = "finished"
-    elif st.log_age_s is not None and st.log_age_s < 300:
-        state = f"running (log written {st.log_age_s:.0f} s ago)"
+    elif st.running:
+        state = "running" + (f" (log written {st.log_age_s:.0f} s ago)" if st.log_age_s is not None else "")
     elif st.reached_time_s is not None:
-        state = f"stopped: run `drumflow run` again to resume (log idle for {_duration(st.log_age_s)})"
+        how = "its process has ended" if st.process_alive is False else "no process recorded"
+        state = (f"stopped: run `drumflow run` again to resume ({how}; log idle for "
+                 f"{_duration(st.log_age_s)})")
     else:
         state = f"DEM not started (stages done: {', '.join(st.stages_done) or 'none'})"
     table.add_row("state", state)
@@ -735,12 +750,30 @@ def ladder(
 guard_every_command(app)
 
 
+_interrupts = 0
+
+
+def _interrupt(signum: int, frame: object) -> None:
+    """SIGINT and SIGTERM: say once what happens now, then raise KeyboardInterrupt (a coupled run
+    writes a restart at its next air update before it stops; a second interrupt stops at once)."""
+    global _interrupts
+    _interrupts += 1
+    if _interrupts == 1:
+        sys.stderr.write(f"\n{signal.Signals(signum).name}: stopping (a run with air first writes a "
+                         "restart at its next air update; interrupt again to stop at once)\n")
+    raise KeyboardInterrupt
+
+
 def main() -> None:
     """Console-script entry point."""
     # SIGTERM (`kill`, a SLURM time limit, the end of a login session) ends a command as Ctrl-C
     # does: the runner stops the solver's process group and the run resumes from its restart.
     # Python's default would end the CLI at once and leave mpirun and its ranks running.
-    signal.signal(signal.SIGTERM, signal.default_int_handler)
+    signal.signal(signal.SIGTERM, _interrupt)
+    # Python installs its Ctrl-C handler only where SIGINT is not ignored (a background job of
+    # a script): an ignored SIGINT stays ignored.
+    if signal.getsignal(signal.SIGINT) is signal.default_int_handler:
+        signal.signal(signal.SIGINT, _interrupt)
     try:
         app()
     except KeyboardInterrupt:  # Ctrl-C outside a command (while parsing arguments)

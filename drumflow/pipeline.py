@@ -7,6 +7,8 @@
 from __future__ import annotations
 
 import json
+import os
+import socket
 import time
 from dataclasses import asdict
 from pathlib import Path
@@ -97,6 +99,9 @@ def run_case(
     rundir = RunDir(out)
     rundir.bind_case(case.canonical_json(), case.hash(), case_to_toml(case), force=force,
                      versions=runner.profile.software_versions())
+    # Who runs in this directory: `drumflow status` tells a live run from one that was killed.
+    rundir.record("process", {"pid": os.getpid(), "host": socket.gethostname(),
+                              "started": time.time()})
     t0 = time.perf_counter()
     # What the DEM moves: the particles, or with particles.coarse_grain their parcels. Geometry,
     # time step and DEM follow the parcels; the air and its coupling the real particles.

@@ -41,6 +41,11 @@ DEFAULT_OPENFOAM_DIR = "/usr/share/openfoam"
 _PACKAGES = ("drumflow", "numpy", "scipy", "pandas", "gmsh", "meshio", "pyvista", "pydantic",
              "jinja2", "foamlib", "matplotlib", "typer", "rich")
 
+#: Seconds an interrupted program may take to stop by itself after its stop request is written
+#: (``Runner.run(stop_request=...)``): the coupling loop finishes its current update interval
+#: and writes a restart (paper model one: about 15 s and 0.3 GB); a second Ctrl-C kills at once.
+STOP_GRACE_S = 120.0
+
 #: Patterns of lines that carry a program's own error message.
 ERROR_PATTERNS = (
     re.compile(r"\bERROR\b"),
@@ -228,6 +233,8 @@ class Runner:
         env: Mapping[str, str] | None = None,
         check: Callable[[int, list[str]], str | None] | None = None,
         follow: Path | None = None,
+        stop_request: Path | None = None,
+        stop_grace: float = STOP_GRACE_S,
     ) -> RunRecord:
         """Run ``command`` in ``cwd``, writing all it prints to ``log``.
 
@@ -252,6 +259,13 @@ class Runner:
             A file the program writes and flushes as it goes (its own log); ``on_line`` then
             gets that file's lines instead of standard output. LIGGGHTS 3.8 flushes its log
             file at every thermo line but leaves standard output buffered until it exits.
+        stop_request
+            A file the program looks for to stop cleanly (the coupling loop writes a restart,
+            then exits). On an interrupt the runner writes it and gives the program
+            ``stop_grace`` seconds to end before killing its process group; the interrupt is
+            raised either way. A stale request is removed before the program starts.
+        stop_grace
+            Seconds allowed for that clean stop.
 
         Raises
         ------
@@ -269,6 +283,8 @@ class Runner:
         full_env = {**os.environ, **self.profile.env, **(env or {})}
         record = RunRecord(program, command, str(cwd), str(log), None, 0.0, time.time())
         self.records.append(record)
+        if stop_request is not None:
+            stop_request.unlink(missing_ok=True)
         with log.open("w", encoding="utf-8", errors="replace") as fh:
             fh.write(f"# drumflow runner: {' '.join(command)}\n# cwd: {cwd}\n")
             fh.flush()
@@ -298,8 +314,13 @@ class Runner:
                     reason=f"{program} ran longer than {timeout:g} s and was stopped",
                 ) from None
             except BaseException:
-                # Ctrl-C (KeyboardInterrupt) or anything else: never leave solvers behind.
-                watch.halt(record, "interrupted")
+                # Ctrl-C (KeyboardInterrupt) or anything else: never leave solvers behind, but
+                # let a program that can stop cleanly do so first.
+                try:
+                    if stop_request is not None:
+                        _request_stop(proc, stop_request, stop_grace)
+                finally:
+                    watch.halt(record, "interrupted")
                 raise
             watch.finish()
             if watch.stops:
@@ -432,6 +453,18 @@ def _follow_file(path: Path, notify: Callable[[str], None], stop: threading.Even
     finally:
         if fh is not None:
             fh.close()
+
+
+def _request_stop(proc: subprocess.Popen[str], request: Path, grace: float) -> None:
+    """Write ``request`` and wait up to ``grace`` seconds for the program to end by itself. A
+    second interrupt during the wait ends the wait (the caller then kills the group)."""
+    if proc.poll() is not None:
+        return
+    try:
+        request.write_text(f"stop requested at {time.strftime('%Y-%m-%d %H:%M:%S')}\n")
+        proc.wait(timeout=grace)
+    except (subprocess.TimeoutExpired, KeyboardInterrupt, OSError):
+        pass
 
 
 def _kill_group(proc: subprocess.Popen[str], grace: float = 5.0) -> None:

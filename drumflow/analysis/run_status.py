@@ -3,7 +3,8 @@
 A paper-scale run takes hours in the background (model one with every particle: about 15 h on
 2 cores), and its progress bar is in a log file. This reads what the run writes anyway (the
 manifest, the stage markers, LIGGGHTS' own log, the coupling loop's per-update wall times and
-the restart files) and says how far it has got, how fast it goes now and when it will end at
+the restart files, and the pid of the ``drumflow run`` process in the manifest) and says
+whether it still runs, how far it has got, how fast it goes now and when it will end at
 that pace, what a resume would start from, and how much disk it holds. No solver is started
 and nothing is written.
 """
@@ -12,6 +13,8 @@ from __future__ import annotations
 
 import json
 import math
+import os
+import socket
 import time
 from dataclasses import asdict, dataclass
 from pathlib import Path
@@ -25,6 +28,9 @@ from drumflow.errors import MissingRunFileError
 #: Updates the recent pace is taken over: about two minutes of model one, long enough to even
 #: out a slow update, short enough to follow the fall in pace as the curtain forms.
 RECENT_UPDATES = 20
+#: A run without a process record counts as running while its log is younger than this, s: a
+#: paper-scale run writes a thermo row every update (about 15 s for model one).
+RUNNING_LOG_AGE_S = 300.0
 #: Bytes read from the end of the newest LIGGGHTS log for its last thermo row.
 LOG_TAIL_BYTES = 65536
 
@@ -48,6 +54,9 @@ class RunStatus:
     log_age_s
         Wall seconds since the newest LIGGGHTS log was written (a running run writes every
         few seconds).
+    process_alive
+        Whether the ``drumflow run`` process the manifest records is alive; None when the run
+        was started on another host or by a drumflow that did not record it.
     wall_per_simulated_s
         Wall seconds per simulated second over the last :data:`RECENT_UPDATES` coupling updates
         that logged a time (runs with air).
@@ -72,6 +81,7 @@ class RunStatus:
     particles: int | None
     particles_initial: int
     log_age_s: float | None
+    process_alive: bool | None
     wall_per_simulated_s: float | None
     eta_s: float | None
     restart_step: int | None
@@ -80,8 +90,18 @@ class RunStatus:
     restart_bytes: int
     output_bytes: int
 
+    @property
+    def running(self) -> bool:
+        """The run is going: its recorded process is alive or, without a record to check (an
+        older run, another host), its log was written in the last :data:`RUNNING_LOG_AGE_S`."""
+        if self.finished:
+            return False
+        if self.process_alive is not None:
+            return self.process_alive
+        return self.log_age_s is not None and self.log_age_s < RUNNING_LOG_AGE_S
+
     def to_dict(self) -> dict[str, Any]:
-        return asdict(self)
+        return {**asdict(self), "running": self.running}
 
 
 STAGE_ORDER = ("geometry", "air", "dem", "post")
@@ -107,6 +127,28 @@ def _recent_pace(coupling_dir: Path, time_step: float) -> float | None:
     updates = updates[~updates["paused"].astype(bool)].tail(RECENT_UPDATES)
     simulated = float((updates["steps"] * time_step).sum())
     return float(updates["wall_s"].sum()) / simulated if simulated > 0 else None
+
+
+def process_alive(record: dict[str, Any] | None) -> bool | None:
+    """Whether the process of a manifest's ``process`` record (pid, host) still runs drumflow:
+    None for another host or no record. The command line is checked too, so that a pid reused
+    by another program after a reboot does not read as a live run."""
+    if not record or record.get("host") != socket.gethostname():
+        return None
+    pid = int(record["pid"])
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # alive, another user's
+        pass
+    cmdline = Path(f"/proc/{pid}/cmdline")
+    if cmdline.exists():
+        try:
+            return b"drumflow" in cmdline.read_bytes()
+        except OSError:
+            return False
+    return True
 
 
 def run_status(run_dir: Path | str, now: float | None = None) -> RunStatus:
@@ -166,6 +208,7 @@ def run_status(run_dir: Path | str, now: float | None = None) -> RunStatus:
         particles=None if row is None else int(row[2]),
         particles_initial=case.dem_case().particle_count,
         log_age_s=age,
+        process_alive=process_alive(manifest.get("process")),
         wall_per_simulated_s=pace,
         eta_s=eta,
         restart_step=newest,

@@ -22,11 +22,16 @@ if TYPE_CHECKING:
     from drumflow.case import Case
     from drumflow.runner import LaunchProfile
 
-__all__ = ["COUPLING_FILE", "CouplingSpec", "FieldSource", "build_coupling", "driver_command",
+__all__ = ["COUPLING_FILE", "STOP_REQUEST", "CouplingSpec", "FieldSource", "build_coupling", "driver_command",
            "loop_heat_options"]
 
 #: The coupling loop's input file, in the DEM working directory.
 COUPLING_FILE = "coupling.json"
+#: The file, in the DEM working directory, that asks a running loop to stop at its next air
+#: update after writing a restart there (spec key ``checkpoint``): the runner writes it when
+#: ``drumflow run`` is interrupted, so that an interrupt loses at most one update interval
+#: instead of everything since the last periodic restart.
+STOP_REQUEST = "stop.request"
 #: Where each rank of the loop writes its log, relative to the DEM working directory.
 COUPLING_LOG_PATTERN = "coupling/rank{rank}.{start}.csv"
 #: The deck's thermo column ``v_overlap`` (drumflow.dem.thermo) on the rows the loop leaves the

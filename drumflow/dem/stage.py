@@ -20,7 +20,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from drumflow.coupling.spec import COUPLING_FILE, CouplingSpec, driver_command
+from drumflow.coupling.spec import COUPLING_FILE, STOP_REQUEST, CouplingSpec, driver_command
 from drumflow.coupling.stop import STOP_RECORD, stop_rule
 from drumflow.dem.deck import (
     RESUME_MESH_PATTERN,
@@ -126,10 +126,13 @@ class DemResult:
     stop: dict[str, Any] | None = None
 
 
-def _add_loop_options(spec_path: Path, case: Case, plan: StepPlan) -> None:
-    """Give the coupling loop the 'converged' stop rule, the in-memory crossings and the rows
-    the overlap bound is evaluated on (:data:`~drumflow.dem.stability.OVERLAP_EVERY_ROWS`)."""
+def _add_loop_options(spec_path: Path, case: Case, plan: StepPlan, checkpoint: str | None) -> None:
+    """Give the coupling loop the 'converged' stop rule, the in-memory crossings, the rows
+    the overlap bound is evaluated on (:data:`~drumflow.dem.stability.OVERLAP_EVERY_ROWS`) and
+    the restart pattern it writes when interrupted (None: a run that is never resumed)."""
     extra: dict[str, Any] = {"overlap_every": OVERLAP_EVERY_ROWS * plan.thermo_step}
+    if checkpoint is not None:
+        extra["checkpoint"] = checkpoint
     rule = stop_rule(case, plan.steps * plan.time_step, plan.dump_every)
     if rule is not None:
         extra["stop"] = rule
@@ -342,20 +345,26 @@ def _launch(case: Case, rundir: RunDir, runner: Runner, inputs: DemInputs, deck_
     log = work / f"liggghts{suffix}.out"
     if own_log.exists():
         own_log.unlink()
+    stop_request: Path | None = None
     if inputs.coupling is None:
+        # LIGGGHTS alone cannot be asked to stop: an interrupt resumes from the last restart.
         command = runner.profile.liggghts_command(deck_name, own_log.name, inputs.processes)
     else:
         spec_path = inputs.coupling.write_driver_file(work, deck_name, own_log.name,
                                                       inputs.plan.steps, inputs.plan.time_step,
                                                       end_commands(context), inputs.plan.thermo_step)
-        _add_loop_options(spec_path, case, inputs.plan)
+        # A short start-up check is never resumed: it writes no restart when interrupted.
+        resumable = inputs.steps is None
+        _add_loop_options(spec_path, case, inputs.plan,
+                          DeckFiles.restart_pattern if resumable else None)
         command = driver_command(runner.profile, inputs.processes, COUPLING_FILE)
+        stop_request = work / STOP_REQUEST if resumable else None
     watcher = _RowWatcher(case, inputs, own_log, rundir.dem_restart, rundir.dem_dumps)
     watcher.command = command
     t0 = time.perf_counter()
     try:
         runner.run("liggghts", command, work, log, timeout=inputs.timeout, on_line=watcher,
-                   check=finished_loop, follow=own_log)
+                   check=finished_loop, follow=own_log, stop_request=stop_request)
     except (UnstableRunError, LostParticlesError):
         rundir.record("stability", watcher.record(stopped=True))
         raise

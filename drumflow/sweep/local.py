@@ -24,6 +24,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import IO, Any
 
+from drumflow.runner import STOP_GRACE_S
 from drumflow.sweep.executor import Attempt, Executor, Ledger
 from drumflow.sweep.spec import LocalSettings, Member, Runs, SweepError
 
@@ -170,9 +171,10 @@ class LocalExecutor(Executor):
         command = self._command(member, run_dir)
         log.write(f"# drumflow sweep (local): {' '.join(command)}\n".encode())
         log.flush()
-        # Same process group as the sweep: Ctrl-C in the terminal reaches every member, and
-        # `drumflow run` stops its solver and exits 130 (resumable).
-        proc = subprocess.Popen(command, stdout=log, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL)
+        # Its own session: the sweep decides how a member is stopped (`interrupt`), so that a
+        # Ctrl-C in the terminal does not reach it twice.
+        proc = subprocess.Popen(command, stdout=log, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL,
+                                start_new_session=True)
         attempt.state = "running"
         attempt.started = time.time()
         attempt.job_id = f"pid {proc.pid}"
@@ -186,15 +188,15 @@ class LocalExecutor(Executor):
         return len(self._running)
 
     def interrupt(self, ledger: Ledger) -> str:
-        # Ctrl-C in a terminal has already reached the members (same process group): give them
-        # time to stop their solvers cleanly before a second SIGINT could cut that short.
-        grace = time.time() + 10.0
-        while time.time() < grace and any(p.poll() is None for p, _, _ in self._running.values()):
-            time.sleep(0.2)
+        # One SIGTERM per member (they run in their own sessions, so a Ctrl-C in the terminal
+        # reached only the sweep): `drumflow run` then stops its solver, a run with air after
+        # writing a restart at its next air update, within the runner's grace; a second signal
+        # would cut that short. SIGTERM, not SIGINT: a member may have inherited an ignored
+        # SIGINT (a background job), never an ignored SIGTERM from drumflow.
         for proc, _, _ in self._running.values():
             if proc.poll() is None:
-                proc.send_signal(signal.SIGINT)
-        deadline = time.time() + 60.0
+                proc.send_signal(signal.SIGTERM)
+        deadline = time.time() + STOP_GRACE_S + 10.0
         for proc, _, _ in self._running.values():
             try:
                 proc.wait(timeout=max(0.1, deadline - time.time()))

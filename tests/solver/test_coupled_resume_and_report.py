@@ -14,7 +14,10 @@ apart (so every particle's heat matters):
   binary restart perturbs the run in the same way (neighbour lists and contact order rebuilt),
   so the resumed run is not bit-identical after the restart (measured: 1e-4 K at most) and must
   be compared against this floor, not against zero;
-* ``faster_air``: 0.2 kg/s instead of 0.1 kg/s, so that two runs at different Re give Table 8.
+* ``faster_air``: 0.2 kg/s instead of 0.1 kg/s, so that two runs at different Re give Table 8;
+* ``checkpointed``: the ``two_ranks`` case run by ``drumflow run`` and sent SIGTERM past
+  0.25 s, half way between two periodic restarts: the coupling loop writes a restart at its next
+  air update and stops, and the rerun resumes from there (before, from the 0.2 s restart).
 
 The CFD field is solved once per air flow (the air cache). On 2 idle cores the module takes
 about 2-3 minutes.
@@ -25,8 +28,10 @@ from __future__ import annotations
 import json
 import math
 import re
+import signal
 import subprocess
 import sys
+import time
 from collections.abc import Callable
 from html import unescape
 from pathlib import Path
@@ -35,6 +40,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 import pytest
+import tomli_w
 from scipy.optimize import curve_fit
 from support.solvers import LIGGGHTS, OPENFOAM, requires_solver
 
@@ -43,7 +49,7 @@ from drumflow.case import Case
 from drumflow.pipeline import run_case
 from drumflow.runner import StopRun
 from drumflow.verify.resume import lifter_angle_at_resume
-from drumflow.verify.scenes import tiny_drum
+from drumflow.verify.scenes import tiny_drum, tiny_drum_dict
 
 pytestmark = [
     pytest.mark.solver,
@@ -95,7 +101,46 @@ def runs(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
     run_case(_case(), out["resumed"], timeout=1200)
     run_case(_case(run__processes=2), out["two_ranks"], timeout=1200)
     run_case(_case(air__mass_flow=0.2), out["faster_air"], timeout=1200)
+    out["checkpointed"] = root / "checkpointed"
+    _interrupt_by_sigterm(root, out["checkpointed"])
+    run_case(_case(**CHECKPOINTED), out["checkpointed"], timeout=1200)
     return out
+
+
+#: The checkpointed run: 2 ranks (every rank must stop at the same update). Its restart
+#: interval is the others' (0.2 s): a periodic restart perturbs the run at round-off (measured
+#: 1e-6 K after it between intervals of 0.2 and 1 s), so the comparison needs the same ones.
+CHECKPOINTED: dict[str, Any] = {"run__processes": 2}
+#: The signal goes once LIGGGHTS has logged this time: half way between the 0.2 and 0.4 s restarts.
+CHECKPOINT_AFTER_S = 0.25
+
+
+def _interrupt_by_sigterm(root: Path, run_dir: Path) -> None:
+    """``drumflow run`` of the checkpointed case, sent SIGTERM once LIGGGHTS has logged 0.25 s;
+    writes ``interrupt.json`` (the time logged when the signal went, the exit code, stderr)."""
+    case_file = root / "checkpointed.toml"
+    case_file.write_text(tomli_w.dumps(tiny_drum_dict(**{**SETTINGS, **CHECKPOINTED})))
+    proc = subprocess.Popen([sys.executable, "-m", "drumflow.cli", "run", str(case_file), "--out",
+                             str(run_dir)], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    reached = None
+    try:
+        deadline = time.monotonic() + 900
+        while proc.poll() is None and time.monotonic() < deadline:
+            try:
+                reached = run_status(run_dir).reached_time_s
+            except Exception:  # the directory is still being set up
+                reached = None
+            if reached is not None and reached >= CHECKPOINT_AFTER_S:
+                break
+            time.sleep(0.2)
+        assert proc.poll() is None, "the run ended before it could be interrupted"
+        proc.send_signal(signal.SIGTERM)
+        _, err = proc.communicate(timeout=300)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    (root / "interrupt.json").write_text(json.dumps(
+        {"signalled_at_s": reached, "returncode": proc.returncode, "stderr": err[-3000:]}))
 
 
 def _series(run: Path) -> pd.DataFrame:
@@ -172,6 +217,41 @@ def test_resumed_run_matches_the_uninterrupted_one(runs: dict[str, Path]) -> Non
     # restart (the same heat logged and integrated, ~1e-9).
     assert cooling > 0.5
     summary = json.loads((runs["resumed"] / "summary.json").read_text())
+    assert summary["energy_balance_error"] < 1e-6
+    assert summary["particles_final"] == 500
+
+
+def test_sigterm_stops_a_run_with_air_at_a_restart_of_its_own(runs: dict[str, Path]) -> None:
+    """Nothing simulated before the signal is lost: the loop wrote a restart at the first air
+    update after it, the rerun resumed from that step, and the result is the uninterrupted
+    run's within its noise floor."""
+    sent = json.loads((runs["checkpointed"].parent / "interrupt.json").read_text())
+    assert sent["returncode"] == 130, sent["stderr"]
+    assert "Traceback" not in sent["stderr"]
+    # The CLI said where the resume starts: the loop's restart, not 0 s.
+    assert re.search(r"from its restart at [0-9.]+ s", " ".join(sent["stderr"].split())), sent
+    dem = _dem(runs["checkpointed"])
+    t_resume = dem["resumed_from_step"] * dem["time_step"]
+    # At or after the time logged when the signal went (the log lags the loop), and before the
+    # next periodic restart (0.4 s; the tiny drum simulates about 0.02 s per wall second on 2
+    # cores, the loop stops within one update of 0.005 s): not a periodic restart's step.
+    assert sent["signalled_at_s"] <= t_resume + 1e-9 < 0.4 - 1e-9, (sent, t_resume)
+    every = dem["dump_every"]  # restarts fall on whole output steps (dem.deck.plan_steps)
+    restart_steps = max(every, round(0.2 / dem["time_step"] / every) * every)
+    assert dem["resumed_from_step"] % restart_steps != 0, dem["resumed_from_step"]
+    angles = lifter_angle_at_resume(runs["checkpointed"])
+    assert angles["resume_step"] == dem["resumed_from_step"]
+    assert abs(angles["mismatch_rad"]) < 1e-6, angles
+    # Up to the restart the same 2-rank computation as `two_ranks`, after it within 5 times the
+    # noise floor (the argument of test_resumed_run_matches_the_uninterrupted_one).
+    T = "mean_temperature_C"
+    ref, resumed, straight = (_series(runs[k]) for k in ("two_ranks", "checkpointed", "straight"))
+    np.testing.assert_array_equal(ref["time_s"], resumed["time_s"])
+    before = ref["time_s"] <= t_resume + 1e-9
+    np.testing.assert_array_equal(ref[T][before], resumed[T][before])
+    noise = (ref[T] - straight[T]).abs()[~before].max()
+    assert (resumed[T] - ref[T]).abs()[~before].max() <= 5.0 * noise
+    summary = json.loads((runs["checkpointed"] / "summary.json").read_text())
     assert summary["energy_balance_error"] < 1e-6
     assert summary["particles_final"] == 500
 

@@ -10,6 +10,10 @@ from __future__ import annotations
 
 import json
 import os
+import socket
+import subprocess
+import sys
+import time
 from pathlib import Path
 
 import pytest
@@ -94,3 +98,36 @@ def test_not_a_run_directory(tmp_path: Path) -> None:
         run_status(tmp_path)
     result = CliRunner().invoke(app, ["status", str(tmp_path)])
     assert result.exit_code == 2 and "manifest" in result.output
+
+
+def test_the_recorded_process_decides_running_or_stopped(tmp_path: Path) -> None:
+    """Regression: a run killed a minute ago read as running for five minutes (its log was
+    young). With the pid `drumflow run` records, a dead process is a stopped run at once and a
+    live one is running however quiet its log."""
+    run = _write_run(tmp_path / "run", last_step=2500, update_walls=[2.0] * 5)
+    manifest = json.loads((run / "manifest.json").read_text())
+    dead = subprocess.Popen([sys.executable, "-c", "pass"])
+    dead.wait()
+    # A live process with "drumflow" on its command line stands in for `drumflow run`; pytest's
+    # own pid is alive but another program (a pid reused after a reboot).
+    live = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(120)", "drumflow"])
+    try:
+        for pid, alive in ((dead.pid, False), (os.getpid(), False), (live.pid, True)):
+            manifest["process"] = {"pid": pid, "host": socket.gethostname(), "started": 0.0}
+            (run / "manifest.json").write_text(json.dumps(manifest))
+            young = run_status(run)  # the logs were just written
+            quiet = run_status(run, now=time.time() + 3600.0)
+            assert young.process_alive is alive and young.running is alive, pid
+            assert quiet.running is alive
+            assert young.to_dict()["running"] is alive
+        result = CliRunner().invoke(app, ["status", str(run)])
+        assert "running" in result.output  # the live stand-in
+    finally:
+        live.kill()
+        live.wait()
+    # Another host's record cannot be checked here: the log's age decides, as without one.
+    manifest["process"] = {"pid": dead.pid, "host": "elsewhere", "started": 0.0}
+    (run / "manifest.json").write_text(json.dumps(manifest))
+    st = run_status(run)
+    assert st.process_alive is None and st.running
+    assert not run_status(run, now=time.time() + 3600.0).running

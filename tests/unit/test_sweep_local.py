@@ -131,3 +131,43 @@ def test_status_of_untouched_members_is_pending(tmp_path: Path) -> None:
     assert [s.state for s in statuses(sd)] == ["pending", "pending"]
     assert (sd.root / "sweep.toml").is_file() and (sd.root / "base.toml").is_file()
     assert (sd.root / "members" / "m001" / "case.toml").is_file()
+
+
+_CHECKPOINTING_MEMBER = textwrap.dedent("""
+    import signal, sys, time
+    from pathlib import Path
+    run_dir = Path(sys.argv[1])
+    run_dir.mkdir(parents=True, exist_ok=True)
+    def note(signum, frame):
+        with open(run_dir / "signals", "a") as fh:
+            fh.write(signal.Signals(signum).name + "\\n")
+        if signum == signal.SIGTERM:
+            time.sleep(1.0)  # `drumflow run` writing its restart at the next air update
+            (run_dir / "checkpoint").write_text("written")
+            sys.exit(130)
+    signal.signal(signal.SIGTERM, note)
+    signal.signal(signal.SIGINT, note)
+    (run_dir / "ready").write_text("")
+    time.sleep(60)
+""")
+
+
+def test_an_interrupted_sweep_signals_each_member_once_and_waits_for_its_restart(
+        tmp_path: Path) -> None:
+    """Regression: the sweep sent a second SIGINT 10 s after the terminal's Ctrl-C, which cuts
+    short the restart a run with air writes when interrupted. Members now run in their own
+    sessions and get exactly one SIGTERM, and the sweep waits for them to end by themselves."""
+    sd = open_sweep(_sweep(tmp_path, [8.0, 9.0]), tmp_path / "out")
+    (tmp_path / "member.py").write_text(_CHECKPOINTING_MEMBER)
+    members = [sd.root / "members" / m for m in ("m000", "m001")]
+
+    def interrupt_once_running(rows: object) -> None:
+        if all((m / "ready").exists() for m in members):
+            raise KeyboardInterrupt
+
+    outcome = run_sweep(sd, _executor(tmp_path, sd, cores=2), on_status=interrupt_once_running)
+    assert outcome.interrupted
+    for m in members:
+        assert (m / "signals").read_text().split() == ["SIGTERM"]
+        assert (m / "checkpoint").read_text() == "written"
+    assert [s.state for s in outcome.statuses] == ["interrupted", "interrupted"]

@@ -1,0 +1,84 @@
+"""The runner's clean stop on an interrupt (``Runner.run(stop_request=...)``), with real child
+processes: a program that watches for the request and ends by itself (as the coupling loop does
+after writing its restart), and one that never looks (killed after the grace)."""
+
+from __future__ import annotations
+
+import _thread
+import sys
+import threading
+from pathlib import Path
+
+import pytest
+
+from drumflow.runner import Runner
+
+#: A stand-in for the coupling loop's side of the protocol: it says it is ready, polls for the
+#: request as the loop does at every air update, then "writes its restart" and exits 0.
+_WATCHER = """
+import pathlib, sys, time
+request, done = pathlib.Path(sys.argv[1]), pathlib.Path(sys.argv[2])
+print("ready", flush=True)
+while not request.exists():
+    time.sleep(0.05)
+done.write_text("restart written")
+"""
+
+_DEAF = """
+import time
+print("ready", flush=True)
+time.sleep(60)
+"""
+
+
+def _interrupt_when_ready(log: Path) -> threading.Thread:
+    """Ctrl-C in the main thread once the child has printed 'ready' (at most 20 s)."""
+
+    def fire() -> None:
+        for _ in range(400):
+            if log.exists() and "ready" in log.read_text():
+                break
+            threading.Event().wait(0.05)
+        _thread.interrupt_main()
+
+    thread = threading.Thread(target=fire, daemon=True)
+    thread.start()
+    return thread
+
+
+def test_an_interrupt_asks_the_program_to_stop_and_waits_for_it(tmp_path: Path) -> None:
+    request, done, log = tmp_path / "stop.request", tmp_path / "restart", tmp_path / "out.log"
+    request.write_text("stale, from an earlier attempt")
+    runner = Runner()
+    _interrupt_when_ready(log)
+    with pytest.raises(KeyboardInterrupt):
+        runner.run("watcher", [sys.executable, "-c", _WATCHER, str(request), str(done)], tmp_path,
+                   log, stop_request=request, stop_grace=30.0)
+    # The stale request was removed before the start (else the program would have stopped at
+    # once, before 'ready'), the new one written on the interrupt, and the program ended by
+    # itself after doing its part: the interrupt is still raised, the record says so.
+    assert done.read_text() == "restart written"
+    assert "stop requested" in request.read_text()
+    assert runner.records[-1].status == "interrupted"
+
+
+def test_without_a_request_file_the_program_is_killed_at_once(tmp_path: Path) -> None:
+    request, done, log = tmp_path / "stop.request", tmp_path / "restart", tmp_path / "out.log"
+    runner = Runner()
+    _interrupt_when_ready(log)
+    with pytest.raises(KeyboardInterrupt):
+        runner.run("watcher", [sys.executable, "-c", _WATCHER, str(request), str(done)], tmp_path, log)
+    assert not request.exists() and not done.exists()
+
+
+def test_a_program_that_does_not_stop_is_killed_after_the_grace(tmp_path: Path) -> None:
+    request, log = tmp_path / "stop.request", tmp_path / "out.log"
+    runner = Runner()
+    _interrupt_when_ready(log)
+    with pytest.raises(KeyboardInterrupt):
+        runner.run("deaf", [sys.executable, "-c", _DEAF], tmp_path, log, stop_request=request,
+                   stop_grace=0.5)
+    record = runner.records[-1]
+    assert request.exists() and record.status == "interrupted"
+    # Killed after the 0.5 s grace plus the group's SIGTERM, not after the program's 60 s.
+    assert record.wall_time_s < 30.0
