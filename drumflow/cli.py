@@ -160,6 +160,39 @@ def _duration(seconds: float | None) -> str:
 
 
 @app.command()
+def stop(
+    run_dir: Annotated[Path, typer.Argument(help="run directory of a running `drumflow run`")],
+    wait: Annotated[bool, typer.Option("--wait/--no-wait", help="wait until the run has stopped")] = True,
+    timeout: Annotated[float, typer.Option("--timeout", min=1, help="longest wait, s")] = 600.0,
+) -> None:
+    """Stop a run with air cleanly: a restart at its next air update, then exit 130 (resumable)."""
+    from drumflow.analysis.run_status import run_status
+    from drumflow.dem.stage import request_stop
+    from drumflow.errors import RunDirectoryError
+
+    st = run_status(run_dir)
+    if not st.running:
+        state = "finished" if st.finished else "stopped"
+        raise RunDirectoryError(f"{run_dir}: no run is going there ({state}); allowed: the "
+                                "directory of a running `drumflow run`")
+    request = request_stop(run_dir)
+    err_console.print(f"asked the run in {run_dir} to stop at its next air update ({request.name})")
+    if not wait:
+        return
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        time.sleep(2.0)
+        st = run_status(run_dir)
+        if not st.running:
+            where = (f"its restart at {st.restart_time_s:.4g} s, step {st.restart_step:,}"
+                     if st.restart_time_s is not None else "no restart")
+            console.print(f"stopped; `drumflow run` again resumes it from {where}")
+            return
+    err_console.print(f"still running after {timeout:g} s: see `drumflow status {run_dir}`")
+    raise typer.Exit(1)
+
+
+@app.command()
 def status(
     run_dir: Annotated[Path, typer.Argument(help="run directory written by `drumflow run`")],
     as_json: Annotated[bool, typer.Option("--json", help="print the status as JSON")] = False,

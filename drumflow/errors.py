@@ -336,6 +336,23 @@ class RunTooShortError(RunDirectoryError):
         )
 
 
+class RunStoppedError(DrumflowError):
+    """A run stopped on request (``drumflow stop``), after writing a restart: interrupted, not
+    failed (exit code 130), and resumed by running the same command again.
+
+    Attributes
+    ----------
+    step, time_s
+        Where the restart was written.
+    """
+
+    def __init__(self, step: int, time_s: float) -> None:
+        self.step = step
+        self.time_s = time_s
+        super().__init__(f"stopped on request at {time_s:.4g} s (step {step:,}), after writing a "
+                         "restart there; run the same command again to resume")
+
+
 class RenderError(DrumflowError, RuntimeError):
     """The particle picture could not be rendered (no OpenGL, crash, time limit, bad data)."""
 
@@ -348,13 +365,14 @@ EXIT_INTERRUPTED = 130
 
 
 def exit_code(exc: BaseException) -> int:
-    """The one exit-code rule: bad input 2, a failed run 1, interrupted 130.
+    """The one exit-code rule: bad input 2, a failed run 1, interrupted 130 (Ctrl-C, SIGTERM, a
+    run stopped on request).
 
     Bad input is every drumflow error that is also a ``ValueError`` (a case or sweep file, an
     argument, a run directory); every other drumflow error is a run that failed. Anything
     else is a bug and also maps to 1 (the CLI shows its traceback).
     """
-    if isinstance(exc, KeyboardInterrupt):
+    if isinstance(exc, KeyboardInterrupt | RunStoppedError):
         return EXIT_INTERRUPTED
     if isinstance(exc, DrumflowError) and isinstance(exc, ValueError):
         return EXIT_BAD_INPUT

@@ -51,7 +51,7 @@ from drumflow.coupling.crossings import CrossingTracker
 from drumflow.coupling.library import Liggghts
 from drumflow.coupling.mpi import allreduce_sum
 from drumflow.coupling.physics import AirState, convective_heat, drag_force
-from drumflow.coupling.spec import OVERLAP_OFF, OVERLAP_ON, STOP_REQUEST
+from drumflow.coupling.spec import OVERLAP_OFF, OVERLAP_ON, STOP_REQUEST, STOPPED_RECORD
 from drumflow.coupling.stop import StopMonitor
 
 #: Per-atom properties the deck defines for the drag (``fix addforce`` reads them).
@@ -249,6 +249,9 @@ def run(spec_path: Path) -> int:
             # applies it): the restart and the logs then describe the same instant.
             if checkpoint and stop_requested(rank, request):
                 lmp.command(f"write_restart {checkpoint}")
+                if rank == 0:
+                    (work / STOPPED_RECORD).write_text(json.dumps({"step": step, "time_s": clock(step)}))
+                    request.unlink(missing_ok=True)
                 checkpointed = True
                 break
             # The monitor's surface is the particles' (k**3 spheres of diameter d per parcel).

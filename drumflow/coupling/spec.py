@@ -22,16 +22,20 @@ if TYPE_CHECKING:
     from drumflow.case import Case
     from drumflow.runner import LaunchProfile
 
-__all__ = ["COUPLING_FILE", "STOP_REQUEST", "CouplingSpec", "FieldSource", "build_coupling", "driver_command",
-           "loop_heat_options"]
+__all__ = ["COUPLING_FILE", "STOPPED_RECORD", "STOP_REQUEST", "CouplingSpec", "FieldSource",
+           "build_coupling", "driver_command", "loop_heat_options"]
 
 #: The coupling loop's input file, in the DEM working directory.
 COUPLING_FILE = "coupling.json"
 #: The file, in the DEM working directory, that asks a running loop to stop at its next air
 #: update after writing a restart there (spec key ``checkpoint``): the runner writes it when
-#: ``drumflow run`` is interrupted, so that an interrupt loses at most one update interval
-#: instead of everything since the last periodic restart.
+#: ``drumflow run`` is interrupted, and ``drumflow stop RUN_DIR`` writes it from outside, so that
+#: a stop loses at most one update interval instead of everything since the last periodic
+#: restart.
 STOP_REQUEST = "stop.request"
+#: What the loop leaves in its place once it has written that restart: ``{"step", "time_s"}``.
+#: Its presence tells the DEM stage that the loop ended on request, not at the end of the run.
+STOPPED_RECORD = "stopped.json"
 #: Where each rank of the loop writes its log, relative to the DEM working directory.
 COUPLING_LOG_PATTERN = "coupling/rank{rank}.{start}.csv"
 #: The deck's thermo column ``v_overlap`` (drumflow.dem.thermo) on the rows the loop leaves the

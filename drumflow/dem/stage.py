@@ -20,7 +20,13 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from drumflow.coupling.spec import COUPLING_FILE, STOP_REQUEST, CouplingSpec, driver_command
+from drumflow.coupling.spec import (
+    COUPLING_FILE,
+    STOP_REQUEST,
+    STOPPED_RECORD,
+    CouplingSpec,
+    driver_command,
+)
 from drumflow.coupling.stop import STOP_RECORD, stop_rule
 from drumflow.dem.deck import (
     RESUME_MESH_PATTERN,
@@ -46,6 +52,8 @@ from drumflow.dem.timestep import TimeStepChoice, choose_time_step
 from drumflow.errors import (
     InsertionError,
     LostParticlesError,
+    RunDirectoryError,
+    RunStoppedError,
     SolverError,
     UnstableRunError,
 )
@@ -58,7 +66,7 @@ if TYPE_CHECKING:
     from drumflow.rundir import RunDir
     from drumflow.runner import Runner
 
-__all__ = ["DemInputs", "DemResult", "ProgressCallback", "dem_key", "plan_run", "run"]
+__all__ = ["DemInputs", "DemResult", "ProgressCallback", "dem_key", "plan_run", "request_stop", "run"]
 
 #: progress(stage, done, total): simulated seconds done out of the total.
 ProgressCallback = Callable[[str, float, float], None]
@@ -169,6 +177,29 @@ def _stage_key(case: Case, inputs: DemInputs) -> str:
     if inputs.coupling is not None:
         key += inputs.coupling.key
     return key
+
+
+def request_stop(run_dir: Path) -> Path:
+    """Ask the coupling loop running in ``run_dir`` to write a restart at its next air update and
+    stop (``drumflow stop``); return the request file. ``drumflow run`` then exits with 130 and
+    resumes from that restart when run again.
+
+    Raises
+    ------
+    RunDirectoryError
+        The run's DEM stage has no coupling loop that looks for the request (no air, or a
+        short start-up check).
+    """
+    dem_dir = Path(run_dir) / "dem"
+    spec = dem_dir / COUPLING_FILE
+    if not spec.is_file() or not json.loads(spec.read_text()).get("checkpoint"):
+        raise RunDirectoryError(
+            f"{Path(run_dir).resolve()}: its DEM run cannot be asked to stop (allowed: a run with "
+            "air, air.model 'uniform' or 'cfd', started by this drumflow); stop it with Ctrl-C or "
+            "`kill PID`, and it resumes from its last periodic restart")
+    request = dem_dir / STOP_REQUEST
+    request.write_text(f"stop requested at {time.strftime('%Y-%m-%d %H:%M:%S')} (drumflow stop)\n")
+    return request
 
 
 def restart_files(folder: Path) -> list[tuple[int, Path]]:
@@ -361,10 +392,17 @@ def _launch(case: Case, rundir: RunDir, runner: Runner, inputs: DemInputs, deck_
         stop_request = work / STOP_REQUEST if resumable else None
     watcher = _RowWatcher(case, inputs, own_log, rundir.dem_restart, rundir.dem_dumps)
     watcher.command = command
+    stopped_record = work / STOPPED_RECORD
+    stopped_record.unlink(missing_ok=True)
     t0 = time.perf_counter()
     try:
         runner.run("liggghts", command, work, log, timeout=inputs.timeout, on_line=watcher,
                    check=finished_loop, follow=own_log, stop_request=stop_request)
+        if stopped_record.exists():
+            # `drumflow stop`: the loop wrote a restart and ended before the run's end.
+            _tidy_output(rundir.dem_restart, rundir.dem_dumps, finished=False)
+            where = json.loads(stopped_record.read_text())
+            raise RunStoppedError(int(where["step"]), float(where["time_s"]))
     except (UnstableRunError, LostParticlesError):
         rundir.record("stability", watcher.record(stopped=True))
         raise

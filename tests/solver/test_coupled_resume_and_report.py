@@ -17,7 +17,10 @@ apart (so every particle's heat matters):
 * ``faster_air``: 0.2 kg/s instead of 0.1 kg/s, so that two runs at different Re give Table 8;
 * ``checkpointed``: the ``two_ranks`` case run by ``drumflow run`` and sent SIGTERM past
   0.25 s, half way between two periodic restarts: the coupling loop writes a restart at its next
-  air update and stops, and the rerun resumes from there (before, from the 0.2 s restart).
+  air update and stops, and the rerun resumes from there (before, from the 0.2 s restart);
+* ``asked_to_stop``: the ``straight`` case with no periodic restart before its end (interval
+  1 s), stopped from outside by ``drumflow stop`` once 0.25 s is logged, and not resumed (the
+  resume is the one above): the one restart it leaves is the loop's.
 
 The CFD field is solved once per air flow (the air cache). On 2 idle cores the module takes
 about 2-3 minutes.
@@ -46,6 +49,7 @@ from support.solvers import LIGGGHTS, OPENFOAM, requires_solver
 
 from drumflow.analysis.run_status import run_status
 from drumflow.case import Case
+from drumflow.dem.stage import restart_files
 from drumflow.pipeline import run_case
 from drumflow.runner import StopRun
 from drumflow.verify.resume import lifter_angle_at_resume
@@ -102,8 +106,10 @@ def runs(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
     run_case(_case(run__processes=2), out["two_ranks"], timeout=1200)
     run_case(_case(air__mass_flow=0.2), out["faster_air"], timeout=1200)
     out["checkpointed"] = root / "checkpointed"
-    _interrupt_by_sigterm(root, out["checkpointed"])
+    _interrupt(root, out["checkpointed"], CHECKPOINTED, "sigterm")
     run_case(_case(**CHECKPOINTED), out["checkpointed"], timeout=1200)
+    out["asked_to_stop"] = root / "asked_to_stop"
+    _interrupt(root, out["asked_to_stop"], {"run__restart_interval": 1.0}, "drumflow stop")
     return out
 
 
@@ -115,14 +121,17 @@ CHECKPOINTED: dict[str, Any] = {"run__processes": 2}
 CHECKPOINT_AFTER_S = 0.25
 
 
-def _interrupt_by_sigterm(root: Path, run_dir: Path) -> None:
-    """``drumflow run`` of the checkpointed case, sent SIGTERM once LIGGGHTS has logged 0.25 s;
-    writes ``interrupt.json`` (the time logged when the signal went, the exit code, stderr)."""
-    case_file = root / "checkpointed.toml"
-    case_file.write_text(tomli_w.dumps(tiny_drum_dict(**{**SETTINGS, **CHECKPOINTED})))
+def _interrupt(root: Path, run_dir: Path, overrides: dict[str, Any], how: str) -> None:
+    """``drumflow run`` of the case with ``overrides``, stopped once LIGGGHTS has logged
+    :data:`CHECKPOINT_AFTER_S`: by SIGTERM, or by ``drumflow stop RUN_DIR`` from outside. Writes
+    ``RUN_DIR.json`` beside the run (the time logged when it was stopped, both exit codes and
+    what they printed)."""
+    case_file = root / f"{run_dir.name}.toml"
+    case_file.write_text(tomli_w.dumps(tiny_drum_dict(**{**SETTINGS, **overrides})))
     proc = subprocess.Popen([sys.executable, "-m", "drumflow.cli", "run", str(case_file), "--out",
                              str(run_dir)], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     reached = None
+    stopper: subprocess.CompletedProcess[str] | None = None
     try:
         deadline = time.monotonic() + 900
         while proc.poll() is None and time.monotonic() < deadline:
@@ -134,13 +143,19 @@ def _interrupt_by_sigterm(root: Path, run_dir: Path) -> None:
                 break
             time.sleep(0.2)
         assert proc.poll() is None, "the run ended before it could be interrupted"
-        proc.send_signal(signal.SIGTERM)
+        if how == "sigterm":
+            proc.send_signal(signal.SIGTERM)
+        else:
+            stopper = subprocess.run([sys.executable, "-m", "drumflow.cli", "stop", str(run_dir)],
+                                     capture_output=True, text=True, timeout=300, check=False)
         _, err = proc.communicate(timeout=300)
     finally:
         if proc.poll() is None:
             proc.kill()
-    (root / "interrupt.json").write_text(json.dumps(
-        {"signalled_at_s": reached, "returncode": proc.returncode, "stderr": err[-3000:]}))
+    (root / f"{run_dir.name}.json").write_text(json.dumps(
+        {"signalled_at_s": reached, "returncode": proc.returncode, "stderr": err[-3000:],
+         "stopper": None if stopper is None else {"returncode": stopper.returncode,
+                                                  "stdout": stopper.stdout, "stderr": stopper.stderr}}))
 
 
 def _series(run: Path) -> pd.DataFrame:
@@ -225,7 +240,7 @@ def test_sigterm_stops_a_run_with_air_at_a_restart_of_its_own(runs: dict[str, Pa
     """Nothing simulated before the signal is lost: the loop wrote a restart at the first air
     update after it, the rerun resumed from that step, and the result is the uninterrupted
     run's within its noise floor."""
-    sent = json.loads((runs["checkpointed"].parent / "interrupt.json").read_text())
+    sent = json.loads((runs["checkpointed"].parent / "checkpointed.json").read_text())
     assert sent["returncode"] == 130, sent["stderr"]
     assert "Traceback" not in sent["stderr"]
     # The CLI said where the resume starts: the loop's restart, not 0 s.
@@ -254,6 +269,28 @@ def test_sigterm_stops_a_run_with_air_at_a_restart_of_its_own(runs: dict[str, Pa
     summary = json.loads((runs["checkpointed"] / "summary.json").read_text())
     assert summary["energy_balance_error"] < 1e-6
     assert summary["particles_final"] == 500
+
+
+def test_drumflow_stop_stops_a_run_at_a_restart_of_its_own(runs: dict[str, Path]) -> None:
+    """`drumflow stop RUN_DIR` from another shell: the run writes a restart at its next air update
+    and exits 130 (interrupted, resumable), and the stop command says where it resumes."""
+    sent = json.loads((runs["asked_to_stop"].parent / "asked_to_stop.json").read_text())
+    stopper = sent["stopper"]
+    assert stopper["returncode"] == 0, stopper
+    assert sent["returncode"] == 130, sent["stderr"]
+    assert "stopped on request at" in " ".join(sent["stderr"].split())
+    assert "Traceback" not in sent["stderr"]
+    said = re.search(r"resumes it from its restart at ([0-9.]+) s, step ([0-9,]+)",
+                     " ".join(stopper["stdout"].split()))
+    assert said, stopper
+    step = int(said.group(2).replace(",", ""))
+    assert [s for s, _ in restart_files(runs["asked_to_stop"] / "dem" / "restart")] == [step]
+    record = json.loads((runs["asked_to_stop"] / "dem" / "stopped.json").read_text())
+    # After the time logged when `drumflow stop` started (its own start-up and the next update
+    # come after: measured 0.25 -> 0.42 s on 2 busy cores), before the run's end.
+    assert record["step"] == step and sent["signalled_at_s"] <= record["time_s"] < 0.6
+    assert not (runs["asked_to_stop"] / "dem" / "stop.request").exists()  # consumed
+    assert not run_status(runs["asked_to_stop"]).running
 
 
 def test_resumed_crossings_match_the_uninterrupted_ones(runs: dict[str, Path]) -> None:

@@ -35,6 +35,7 @@ from drumflow.errors import (
     LostParticlesError,
     RenderError,
     RunDirectoryError,
+    RunStoppedError,
     SettingsStudyError,
     SolverError,
     SolverTimeoutError,
@@ -112,6 +113,7 @@ def test_report_of_a_directory_that_is_not_a_run_writes_nothing(tmp_path: Path) 
         (InsertionError(10, 9), EXIT_FAILED),
         (RenderError("no OpenGL"), EXIT_FAILED),
         (KeyboardInterrupt(), EXIT_INTERRUPTED),
+        (RunStoppedError(4160, 0.262), EXIT_INTERRUPTED),  # `drumflow stop`: resumable
         (RuntimeError("a bug"), EXIT_FAILED),
     ],
 )

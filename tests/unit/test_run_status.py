@@ -22,7 +22,8 @@ from typer.testing import CliRunner
 from drumflow.analysis.run_status import LOG_TAIL_BYTES, RECENT_UPDATES, run_status
 from drumflow.case import case_to_toml, load_case
 from drumflow.cli import app
-from drumflow.errors import MissingRunFileError
+from drumflow.dem.stage import request_stop
+from drumflow.errors import MissingRunFileError, RunDirectoryError
 
 ROOT = Path(__file__).resolve().parents[2]
 DT = 1e-4
@@ -131,3 +132,27 @@ def test_the_recorded_process_decides_running_or_stopped(tmp_path: Path) -> None
     st = run_status(run)
     assert st.process_alive is None and st.running
     assert not run_status(run, now=time.time() + 3600.0).running
+
+
+def test_drumflow_stop_refuses_a_run_that_is_not_going(tmp_path: Path) -> None:
+    run = _write_run(tmp_path / "run", last_step=2500, update_walls=[2.0] * 5)
+    manifest = json.loads((run / "manifest.json").read_text())
+    dead = subprocess.Popen([sys.executable, "-c", "pass"])
+    dead.wait()
+    manifest["process"] = {"pid": dead.pid, "host": socket.gethostname(), "started": 0.0}
+    (run / "manifest.json").write_text(json.dumps(manifest))
+    result = CliRunner().invoke(app, ["stop", str(run)])
+    assert result.exit_code == 2 and "no run is going there (stopped)" in " ".join(result.output.split())
+    assert not (run / "dem" / "stop.request").exists()
+
+
+def test_a_run_without_a_coupling_loop_cannot_be_asked_to_stop(tmp_path: Path) -> None:
+    run = _write_run(tmp_path / "run", last_step=2500, update_walls=[2.0] * 5)
+    with pytest.raises(RunDirectoryError, match="cannot be asked to stop"):
+        request_stop(run)  # no dem/coupling.json: LIGGGHTS alone
+    (run / "dem" / "coupling.json").write_text(json.dumps({"interval": 50}))
+    with pytest.raises(RunDirectoryError, match="cannot be asked to stop"):
+        request_stop(run)  # a loop without a restart pattern (a study's, a short check's)
+    (run / "dem" / "coupling.json").write_text(json.dumps({"checkpoint": "restart/drum.*.restart"}))
+    assert request_stop(run) == run / "dem" / "stop.request"
+    assert "drumflow stop" in (run / "dem" / "stop.request").read_text()
