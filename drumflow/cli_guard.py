@@ -20,7 +20,7 @@ import typer
 from rich.console import Console
 from rich.markup import escape
 
-from drumflow.errors import DrumflowError, exit_code
+from drumflow.errors import DrumflowError, RunStoppedError, exit_code
 
 __all__ = ["cli_console", "guard", "guard_every_command"]
 
@@ -46,6 +46,10 @@ def guard(console: Console | None = None) -> Iterator[None]:
     out = console or _err_console
     try:
         yield
+    except RunStoppedError as exc:
+        # Asked for (`drumflow stop`, a time limit's warning): an interruption, not an error.
+        out.print(escape(str(exc)), highlight=False)
+        raise typer.Exit(exit_code(exc)) from None
     except DrumflowError as exc:
         # Escaped: an error's text is plain (a list in brackets, a TOML [section]), not markup.
         out.print(f"[bold red]error:[/] {escape(str(exc))}", highlight=False)

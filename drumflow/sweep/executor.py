@@ -32,7 +32,8 @@ ATTEMPTS_FILE = "executor/attempts.json"
 
 #: ``pending``: submitted, not started; ``running``; ``completed``: exit code 0 (the member is
 #: done if its run directory says so); ``failed``: non-zero exit, cancelled, timed out, node
-#: failure; ``interrupted``: stopped by the user (Ctrl-C) before it finished; resumed on rerun.
+#: failure; ``interrupted``: stopped before it finished by the user (Ctrl-C) or, under SLURM,
+#: after writing a restart before its time limit (exit 130); resumed on rerun.
 AttemptState = Literal["pending", "running", "completed", "failed", "interrupted"]
 
 #: States after which an attempt will not change any more.

@@ -35,7 +35,7 @@ from datetime import datetime
 from pathlib import Path
 from typing import Any
 
-from drumflow.errors import SlurmError
+from drumflow.errors import EXIT_INTERRUPTED, SlurmError
 from drumflow.sweep.executor import Attempt, Executor, Ledger
 from drumflow.sweep.spec import Member, Runs, SlurmSettings, SweepError, member_id
 
@@ -144,8 +144,21 @@ echo "drumflow sweep: member $member, array task $job (job $SLURM_JOB_ID) on $(h
 # must not take SLURM's task count (1) as its slots, nor start daemons on other nodes.
 export OMPI_MCA_ras=^slurm OMPI_MCA_plm=isolated
 srun --ntasks=1 --cpus-per-task={n} {self.drumflow_command()} run "$member_dir/case.toml" \\
-    --out "$member_dir" --np {n}{timeout}
-rc=$?
+    --out "$member_dir" --np {n}{timeout} &
+run_pid=$!
+# SLURM's warning before the time limit (sbatch --signal=B:USR1@N) reaches this shell only: the
+# run is asked to write a restart at its next air update and stop (exit 130), instead of being
+# killed at the limit and losing everything since its last periodic restart.
+stop_member() {{
+    echo "drumflow sweep: time limit near, asking $member to stop"
+    {self.drumflow_command()} stop "$member_dir" --no-wait
+}}
+trap stop_member USR1
+while true; do
+    wait "$run_pid"
+    rc=$?
+    kill -0 "$run_pid" 2>/dev/null || break  # a trapped signal ended the wait, not the run
+done
 printf '{{"job_id": "%s", "node": "%s", "started": %s, "ended": %s, "exit_code": %s}}\\n' \\
     "$job" "$(hostname -s)" "$started" "$(date +%s)" "$rc" > "$member_dir/slurm-$job.json"
 exit $rc
@@ -168,6 +181,8 @@ exit $rc
             args.append(f"--account={s.account}")
         if s.time_limit:
             args.append(f"--time={s.time_limit}")
+        if s.stop_before_limit > 0:
+            args.append(f"--signal=B:USR1@{s.stop_before_limit}")
         return args + list(s.sbatch_options)
 
     def _write_script(self) -> Path:
@@ -343,6 +358,11 @@ exit $rc
             if info is None:
                 attempt.state = "completed" if own.get("exit_code") == 0 else "failed"
                 attempt.ended = own.get("ended")
+            if own.get("exit_code") == EXIT_INTERRUPTED:
+                # Stopped before its time limit (or by `drumflow stop`) after writing a restart:
+                # not a failure, and the next `drumflow sweep` resumes it.
+                attempt.state = "interrupted"
+                attempt.reason = "stopped after writing a restart; resumed on rerun"
 
     def _own_record(self, attempt: Attempt) -> dict[str, Any] | None:
         path = self.root / "members" / attempt.member / f"slurm-{attempt.job_id}.json"

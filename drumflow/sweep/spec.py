@@ -162,6 +162,12 @@ class SlurmSettings(_Section):
         None, pattern=r"^(\d+-)?\d+(:\d{2}){0,2}$",
         description="sbatch --time per member, e.g. '02:00:00' or '1-00:00:00'",
     )
+    stop_before_limit: int = Field(
+        300, ge=0, le=86_400,
+        description="seconds before the time limit at which a member is asked to write a restart "
+        "and stop (sbatch --signal=B:USR1@N; `drumflow stop`), so the rerun resumes from there; "
+        "0: off (the limit kills it, and it resumes from its last periodic restart)",
+    )
     sbatch_options: list[str] = Field(
         default_factory=list, description="more sbatch options, e.g. ['--mem=4G', '--qos=long']"
     )

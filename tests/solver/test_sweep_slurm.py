@@ -167,3 +167,62 @@ def test_slurm_sweep_survives_a_killed_member_and_matches_local(tmp_path: Path, 
     assert "data:image/png;base64," in page and "Member fit" in page
     fit = json.loads((slurm_dir / "analysis" / "fit.json").read_text())
     assert [m["analysed"] for m in fit["members"]] == [True] * 4
+
+
+@pytest.mark.timeout(1200)
+def test_a_member_warned_of_its_time_limit_stops_at_a_restart_and_resumes(
+        tmp_path: Path, slurm_cluster: None) -> None:
+    """SLURM's warning before a time limit (``--signal=B:USR1@300``, here sent at once with
+    ``scancel --batch --signal=USR1``, which reaches the batch shell only, as B: does): the
+    member is asked to stop, writes a restart at its next air update, exits 130 and is
+    'interrupted', not failed; the next `drumflow sweep` resumes it from that restart."""
+    from drumflow.dem.stage import restart_files
+    from drumflow.verify.scenes import tiny_drum_dict
+
+    # No periodic restart before the end (interval 1 s): the one restart left is the loop's.
+    base = tiny_drum_dict(air__model="uniform", air__mass_flow=0.1, run__time=1.0,
+                          run__mass_flow_start=0.2, run__restart_interval=1.0)
+    (tmp_path / "tiny.toml").write_text(tomli_w.dumps(base))
+    sweep_file = tmp_path / "sweep_limit.toml"
+    sweep_file.write_text(tomli_w.dumps({
+        "name": "tiny_limit", "base": "tiny.toml", "axes": {"drum.rpm": [30.0]},
+        "runs": {"processes": 1, "timeout": 900},
+        "executor": {"kind": "slurm", "slurm": {"time_limit": "00:30:00", "poll_interval": 1.0}},
+    }))
+    out = tmp_path / "limit_run"
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "drumflow.cli", "sweep", str(sweep_file), "--out", str(out)],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+    )
+    job, warned_at = None, None
+    deadline = time.time() + 600
+    while time.time() < deadline and proc.poll() is None:
+        members = sorted((out / "members").glob("m*")) if (out / "members").exists() else []
+        t = simulated_time(members[0]) if members else None
+        if t is not None and t >= 0.3:
+            attempts = json.loads((out / "executor" / "attempts.json").read_text())
+            job, warned_at = attempts[-1]["job_id"], t
+            subprocess.run(["scancel", "--batch", "--signal=USR1", job], check=True)
+            break
+        time.sleep(0.3)
+    assert job is not None, "the member never ran long enough under SLURM to be warned"
+    _, stderr = proc.communicate(timeout=600)
+    member = sorted((out / "members").glob("m*"))[0]
+    attempts = json.loads((out / "executor" / "attempts.json").read_text())
+    assert [(a["state"], a["exit_code"]) for a in attempts] == [("interrupted", "130")], stderr[-3000:]
+    # The batch script asked for the warning, and the loop wrote its restart after it.
+    sub = json.loads((out / "slurm" / "submissions.json").read_text())
+    assert "--signal=B:USR1@300" in json.dumps(sub)
+    stopped = json.loads((member / "dem" / "stopped.json").read_text())
+    assert [s for s, _ in restart_files(member / "dem" / "restart")] == [stopped["step"]]
+    assert warned_at <= stopped["time_s"] < 1.0
+    log = next((out / "slurm" / "logs").glob("*.out")).read_text()
+    assert "time limit near" in log
+
+    second = _sweep(str(out), "--json")
+    assert second.returncode == 0, second.stderr[-3000:]
+    assert [r["state"] for r in json.loads(second.stdout)] == ["done"]
+    dem = json.loads((member / "stages" / "dem.json").read_text())["result"]
+    assert dem["resumed_from_step"] == stopped["step"]
+    summary = json.loads((member / "summary.json").read_text())
+    assert summary["particles_final"] == 500 and summary["energy_balance_error"] < 1e-6

@@ -137,6 +137,21 @@ def test_an_error_in_brackets_is_printed_as_written() -> None:
     assert "differs in [particles, air]; see [bold]" in buffer.getvalue()
 
 
+def test_a_requested_stop_is_not_printed_as_an_error() -> None:
+    # Regression: a member stopped before its SLURM time limit logged "error: stopped on request".
+    import io
+
+    from rich.console import Console
+
+    from drumflow.cli_guard import guard
+
+    buffer = io.StringIO()
+    with pytest.raises(typer.Exit) as exit_info, guard(Console(file=buffer, width=200)):
+        raise RunStoppedError(7840, 0.4937)
+    assert exit_info.value.exit_code == EXIT_INTERRUPTED
+    assert buffer.getvalue().startswith("stopped on request at 0.4937 s (step 7,840)")
+
+
 def test_every_error_class_lives_in_errors_py() -> None:
     # Error classes defined elsewhere could not be found (and mapped) in one place.
     import ast
