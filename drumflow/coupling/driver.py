@@ -20,9 +20,11 @@ adds them up.
 Interrupts: with the spec key ``checkpoint`` (a restart file pattern), the loop looks for
 :data:`~drumflow.coupling.spec.STOP_REQUEST` at every air update; once it is there, every rank
 stops at the same update, writes a restart at that step and leaves the loop. The runner writes
-that file when ``drumflow run`` is interrupted (Ctrl-C, ``kill``, a batch system's SIGTERM), so
-the run resumes from where it was stopped, not from its last periodic restart (half a
-simulated second, about 40 minutes of paper model one).
+that file when ``drumflow run`` is interrupted (Ctrl-C, ``kill`` of its pid) and ``drumflow
+stop`` from outside (a SLURM sweep on its time-limit warning), so the run resumes from where it
+was stopped, not from its last periodic restart (half a simulated second, about 40 minutes of
+paper model one). A signal that reaches mpirun itself ends the ranks at once: mpirun runs in its
+own session, so only a signal to the whole job does that.
 
 One-way coupling as in the paper: the air keeps its field and its inlet temperature.
 
