@@ -56,6 +56,7 @@ from drumflow.coupling.spec import (
     loop_heat_options,
 )
 from drumflow.dem.deck import processors_grid
+from drumflow.dem.restitution import calibrate_case
 from drumflow.dem.stage import DemInputs, finished_loop, latest_restart, write_deck
 from drumflow.dem.thermo import read_thermo
 from drumflow.errors import DrumflowError, SettingsStudyError
@@ -153,6 +154,10 @@ VARIANTS: list[Variant] = [
     # i.e. the reference as drumflow ran it before the axial grid.
     Variant("conservative", "half the time step (20 steps per contact) and the moving-mesh shell",
             time_step_factor=0.5, moving_shell=True),
+    # Its two parts on their own: which one moves the bed (model one's kinetic energy).
+    Variant("half_step", "half the time step (20 steps per contact), the static shell",
+            time_step_factor=0.5),
+    Variant("moving_shell", "the moving-mesh shell, the default time step", moving_shell=True),
     Variant("conservative_grid_x", "conservative, on the processor grid across the drum (x)",
             time_step_factor=0.5, moving_shell=True, processors="{np} 1 1", min_ranks=2),
 ]
@@ -183,8 +188,9 @@ def _scale_value(deck: str, keyword: str, factor: float, fmt: str, suffix: str =
     return _replace_line(deck, rf"^{keyword}\s+.*$", f"{keyword:<16}{value}")
 
 
-def apply_variant(deck: str, variant: Variant, ranks: int) -> str:
-    """The baseline deck with the variant's settings."""
+def apply_variant(deck: str, variant: Variant, ranks: int, case: Case) -> str:
+    """The baseline deck with the variant's settings; ``case`` calibrates the restitution of a
+    variant with another time step."""
     if variant.skin_factor != 1.0:
         deck = _scale_value(deck, "neighbor", variant.skin_factor, "{:.6g} bin", suffix=r"\s+bin")
     if variant.neigh_modify is not None:
@@ -199,6 +205,7 @@ def apply_variant(deck: str, variant: Variant, ranks: int) -> str:
                              f"processors      {variant.processors.format(np=ranks)}")
     if variant.time_step_factor != 1.0:
         deck = _scale_value(deck, "timestep", variant.time_step_factor, "{:.12g}")
+        deck = _restitution_at(deck, case)
     if variant.moving_shell:
         pattern = (r"^fix shell all mesh/surface file (\S+) type 2 surface_ang_vel origin (\S+ \S+ \S+) "
                    r"axis (\S+ \S+ \S+) omega (\S+)\s*$")
@@ -231,6 +238,22 @@ def apply_variant(deck: str, variant: Variant, ranks: int) -> str:
             deck = (deck[:m.start()] + OVERLAP_OFF.replace("overlap", "no_overlap", 1) + "\n"
                     + line + deck[m.end():])
     return deck
+
+
+def _restitution_at(deck: str, case: Case) -> str:
+    """The deck's restitution coefficients calibrated for its (new) time step, as a run at that
+    step has them (drumflow.dem.restitution): LIGGGHTS' realised restitution depends on the steps
+    per contact, so the baseline's coefficients at half the step realise e_pp 0.111 instead of
+    the case's 0.1 (paper model one)."""
+    m = re.search(r"^timestep\s+(\S+)\s*$", deck, flags=re.M)
+    if m is None:
+        raise SettingsStudyError("deck: no `timestep` line")
+    calibrated = calibrate_case(case, float(m.group(1)))
+    e_pp = f"{calibrated['particle_particle'].liggghts_value:.6g}"
+    e_pw = f"{calibrated['particle_wall'].liggghts_value:.6g}"
+    return _replace_line(deck, r"^fix m3 all property/global coefficientRestitution .*$",
+                         "fix m3 all property/global coefficientRestitution peratomtypepair 2 "
+                         f"{e_pp} {e_pw} {e_pw} {e_pw}")
 
 
 def variant_steps(steps: int, variant: Variant) -> int:
@@ -508,7 +531,7 @@ def run_settings_study(case: Case, run_dir: Path, out: Path, steps: int = 400, r
                 on_variant(variant, index, len(variants), None)
             folder = scratch / variant.name
             n_steps = variant_steps(steps, variant)
-            _prepare(folder, rundir, restart, apply_variant(deck, variant, ranks), driver,
+            _prepare(folder, rundir, restart, apply_variant(deck, variant, ranks, case.dem_case()), driver,
                      start + n_steps, variant.time_step_factor, start, variant.no_conduction,
                      overlap_every_row=variant.overlap_every_row or variant.no_overlap)
             t0 = time.perf_counter()

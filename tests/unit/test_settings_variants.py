@@ -1,0 +1,65 @@
+"""The settings study's deck edits (drumflow.bench.settings.apply_variant) that need no solver;
+tests/solver/test_profile.py runs every variant through LIGGGHTS."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import pytest
+
+from drumflow.bench.settings import VARIANTS, apply_variant
+from drumflow.case import load_case
+from drumflow.dem.restitution import calibrate_case, mean_realised_restitution, pair_properties
+from drumflow.dem.stage import plan_run
+from drumflow.dem.timestep import typical_impact_velocity
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def _deck(time_step: float, e_pp: float, e_pw: float) -> str:
+    return (f"timestep        {time_step:.12g}\n"
+            f"fix m3 all property/global coefficientRestitution peratomtypepair 2 {e_pp:.6g} {e_pw:.6g} "
+            f"{e_pw:.6g} {e_pw:.6g}\n")
+
+
+def _coefficients(deck: str) -> tuple[float, float]:
+    m = re.search(r"coefficientRestitution peratomtypepair 2 (\S+) (\S+) \S+ \S+", deck)
+    assert m is not None
+    return float(m.group(1)), float(m.group(2))
+
+
+@pytest.mark.parametrize("name", ["half_step", "conservative"])
+def test_a_time_step_variant_gets_the_restitution_a_run_at_its_step_has(name: str) -> None:
+    """Regression: the half-step variants kept the baseline's calibrated coefficients, which at
+    20 steps per contact realise e_pp 0.111 instead of the case's 0.1 (paper model one), so the
+    'conservative reference' was a more elastic bed than a run at that step."""
+    case = load_case(ROOT / "cases" / "paper_model_one.toml")
+    _, plan = plan_run(case)
+    base = calibrate_case(case, plan.time_step)
+    deck = _deck(plan.time_step, base["particle_particle"].liggghts_value,
+                 base["particle_wall"].liggghts_value)
+    variant = next(v for v in VARIANTS if v.name == name)
+    if variant.moving_shell:
+        deck += ("fix shell all mesh/surface file shell.stl type 2 surface_ang_vel origin 0 0 0 "
+                 "axis 0 0 1 omega 0.5236\nfix walls all wall/gran model hertz mesh n_meshes 1 "
+                 "meshes shell\n")
+    e_pp, e_pw = _coefficients(apply_variant(deck, variant, 2, case))
+    half = 0.5 * plan.time_step
+    speed = typical_impact_velocity(case)
+    for given, name_, wall in ((e_pp, "particle_particle", False), (e_pw, "particle_wall", True)):
+        target = getattr(case.contacts, name_).restitution
+        m, r, e = pair_properties(case, wall)
+        # What LIGGGHTS' discrete contact realises at the variant's step is the case's value
+        # (to the 6 digits the deck carries), and not what the baseline's coefficient gives.
+        assert mean_realised_restitution(given, half, m, r, e, speed) == pytest.approx(target, rel=1e-4)
+        stale = base[name_].liggghts_value
+        assert abs(mean_realised_restitution(stale, half, m, r, e, speed) - target) > 0.005 * target
+
+
+def test_a_variant_with_the_baseline_step_keeps_the_coefficients() -> None:
+    case = load_case(ROOT / "cases" / "paper_model_one.toml")
+    deck = _deck(1.2e-4, 0.1205, 0.313)
+    skin = next(v for v in VARIANTS if v.name == "skin_x2")
+    edited = apply_variant(deck + "neighbor        0.004 bin\n", skin, 2, case)
+    assert _coefficients(edited) == (0.1205, 0.313)
