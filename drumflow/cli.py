@@ -209,6 +209,9 @@ def status(
         state = "finished"
     elif st.running:
         state = "running" + (f" (log written {st.log_age_s:.0f} s ago)" if st.log_age_s is not None else "")
+    elif st.stopped_on_request_s is not None:
+        state = (f"stopped on request at {st.stopped_on_request_s:.4g} s, after writing a restart "
+                 "there: run `drumflow run` again to resume")
     elif st.reached_time_s is not None:
         how = "its process has ended" if st.process_alive is False else "no process recorded"
         state = (f"stopped: run `drumflow run` again to resume ({how}; log idle for "

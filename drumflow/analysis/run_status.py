@@ -21,6 +21,7 @@ from pathlib import Path
 from typing import Any
 
 from drumflow.coupling.log import read_coupling, update_walls
+from drumflow.coupling.spec import STOPPED_RECORD
 from drumflow.dem.stage import restart_files
 from drumflow.dem.thermo import COLUMNS, ThermoParser, log_files
 from drumflow.errors import MissingRunFileError
@@ -69,6 +70,9 @@ class RunStatus:
         Restart files kept and their size.
     output_bytes
         Everything else in the run directory.
+    stopped_on_request_s
+        Where the coupling loop wrote its restart when it was last asked to stop (``drumflow
+        stop``, an interrupt, a SLURM time-limit warning), s; None if the last attempt was not.
     """
 
     run_dir: str
@@ -89,6 +93,7 @@ class RunStatus:
     restarts: int
     restart_bytes: int
     output_bytes: int
+    stopped_on_request_s: float | None = None
 
     @property
     def running(self) -> bool:
@@ -127,6 +132,14 @@ def _recent_pace(coupling_dir: Path, time_step: float) -> float | None:
     updates = updates[~updates["paused"].astype(bool)].tail(RECENT_UPDATES)
     simulated = float((updates["steps"] * time_step).sum())
     return float(updates["wall_s"].sum()) / simulated if simulated > 0 else None
+
+
+def _stopped_on_request(dem: Path) -> float | None:
+    path = dem / STOPPED_RECORD  # removed when the next attempt starts
+    try:
+        return float(json.loads(path.read_text())["time_s"])
+    except (OSError, ValueError, KeyError, TypeError):
+        return None
 
 
 def process_alive(record: dict[str, Any] | None) -> bool | None:
@@ -217,4 +230,5 @@ def run_status(run_dir: Path | str, now: float | None = None) -> RunStatus:
         restarts=len(restarts),
         restart_bytes=restart_bytes,
         output_bytes=total - restart_bytes,
+        stopped_on_request_s=_stopped_on_request(dem),
     )

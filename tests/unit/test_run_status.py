@@ -156,3 +156,15 @@ def test_a_run_without_a_coupling_loop_cannot_be_asked_to_stop(tmp_path: Path) -
     (run / "dem" / "coupling.json").write_text(json.dumps({"checkpoint": "restart/drum.*.restart"}))
     assert request_stop(run) == run / "dem" / "stop.request"
     assert "drumflow stop" in (run / "dem" / "stop.request").read_text()
+
+
+def test_a_run_stopped_on_request_says_so(tmp_path: Path) -> None:
+    run = _write_run(tmp_path / "run", last_step=2500, update_walls=[2.0] * 5)
+    (run / "dem" / "stopped.json").write_text(json.dumps({"step": 2500, "time_s": 0.25}))
+    st = run_status(run, now=time.time() + 3600.0)
+    assert not st.running and st.stopped_on_request_s == pytest.approx(0.25)
+    old = time.time() - 3600.0
+    for log in (run / "dem").glob("log*"):
+        os.utime(log, (old, old))
+    result = CliRunner().invoke(app, ["status", str(run)])
+    assert "stopped on request at 0.25 s" in " ".join(result.output.split())
