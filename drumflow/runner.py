@@ -300,7 +300,15 @@ class Runner:
                 bufsize=1,
                 start_new_session=True,  # own process group: killpg reaches mpirun's ranks
             )
-            watch = _Watch(proc, fh, on_line, follow)
+            try:
+                # Inside the try: an interrupt while the output threads start (a loaded machine
+                # can take a while to schedule them) must not leave the program running.
+                watch = _Watch(proc, fh, on_line, follow)
+            except BaseException:
+                _kill_group(proc)
+                record.status = "interrupted"
+                record.wall_time_s = time.time() - record.started
+                raise
             try:
                 _wait(proc, watch, record.started, timeout)
             except subprocess.TimeoutExpired:

@@ -82,3 +82,32 @@ def test_a_program_that_does_not_stop_is_killed_after_the_grace(tmp_path: Path) 
     assert request.exists() and record.status == "interrupted"
     # Killed after the 0.5 s grace plus the group's SIGTERM, not after the program's 60 s.
     assert record.wall_time_s < 30.0
+
+
+def test_an_interrupt_while_the_output_threads_start_kills_the_program(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Regression: Ctrl-C between the program's start and the runner's try left it running (the
+    full unit suite on a loaded machine once found the exit-code test's launcher alive after
+    `drumflow run` had exited 130)."""
+    import os
+
+    from drumflow import runner as runner_module
+
+    pid_file = tmp_path / "pid"
+
+    def interrupted(proc: object, *args: object) -> None:
+        for _ in range(200):  # the child has started and written its pid
+            if pid_file.exists() and pid_file.read_text().strip():
+                break
+            threading.Event().wait(0.05)
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(runner_module, "_Watch", interrupted)
+    runner = Runner()
+    program = f"import os, time; open({str(pid_file)!r}, 'w').write(str(os.getpid())); time.sleep(60)"
+    with pytest.raises(KeyboardInterrupt):
+        runner.run("sleeper", [sys.executable, "-c", program], tmp_path, tmp_path / "out.log")
+    pid = int(pid_file.read_text())
+    with pytest.raises(ProcessLookupError):
+        os.kill(pid, 0)
+    assert runner.records[-1].status == "interrupted"
