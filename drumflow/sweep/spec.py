@@ -51,6 +51,7 @@ __all__ = [
     "expand",
     "load_sweep",
     "member_id",
+    "time_limit_seconds",
 ]
 
 _RANGE_KEYS = frozenset({"start", "stop", "num", "step"})
@@ -180,6 +181,31 @@ class SlurmSettings(_Section):
         description="how the nodes start drumflow (default: this Python's `-m drumflow.cli`)",
     )
     poll_interval: float = Field(10.0, gt=0, le=600, description="squeue polling interval, s")
+
+    @model_validator(mode="after")
+    def _warning_inside_the_limit(self) -> SlurmSettings:
+        limit = time_limit_seconds(self.time_limit) if self.time_limit else None
+        if limit is not None and self.stop_before_limit >= limit:
+            raise ValueError(
+                f"stop_before_limit = {self.stop_before_limit} s is not below time_limit = "
+                f"{self.time_limit!r} ({limit} s): the member would be asked to stop as it starts; "
+                f"allowed: 0 (off) to {limit - 1} s")
+        return self
+
+
+def time_limit_seconds(limit: str) -> int:
+    """A SLURM time limit (``[D-]HH:MM:SS``, ``MM:SS``, ``MM``) in seconds."""
+    days, _, clock = limit.rpartition("-")
+    parts = [int(x) for x in clock.split(":")]
+    if days:  # with days, SLURM reads the clock as hours[:minutes[:seconds]]
+        parts += [0] * (3 - len(parts))
+        hours, minutes, seconds = parts
+        return ((int(days) * 24 + hours) * 60 + minutes) * 60 + seconds
+    if len(parts) == 1:
+        return parts[0] * 60
+    if len(parts) == 2:
+        return parts[0] * 60 + parts[1]
+    return (parts[0] * 60 + parts[1]) * 60 + parts[2]
 
 
 class ExecutorSpec(_Section):

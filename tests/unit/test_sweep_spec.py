@@ -13,7 +13,7 @@ import tomli_w
 
 from drumflow.case import load_case
 from drumflow.errors import exit_code
-from drumflow.sweep.spec import SweepError, load_sweep
+from drumflow.sweep.spec import SweepError, load_sweep, time_limit_seconds
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -103,6 +103,8 @@ def test_latin_hypercube_is_seeded_stratified_and_rounds_integer_fields(tmp_path
         ({"axes": {"lifters": [{"profile": "L", "lip_lenght": 0.02}]}}, "axes.lifters.lip_lenght"),
         ({"axes": {"drum.rpm": [10.0]}, "design": {"kind": "latin_hypercube"}}, "design.samples"),
         ({"axes": {"drum.rpm": [10.0]}, "runs": {"processes": 0}}, "runs.processes = 0"),
+        ({"axes": {"drum.rpm": [10.0]}, "executor": {"slurm": {"time_limit": "00:04:00"}}},
+         "stop_before_limit = 300 s is not below time_limit = '00:04:00' (240 s)"),
     ],
 )
 def test_bad_sweep_files_are_refused_naming_the_field(tmp_path: Path, sweep: dict[str, Any],
@@ -137,3 +139,12 @@ def test_cli_refuses_a_bad_sweep_with_exit_2_and_no_traceback(tmp_path: Path) ->
 def test_shipped_sweep_file_is_valid_toml_with_both_executors() -> None:
     data = tomllib.loads((ROOT / "cases" / "sweep_smoke.toml").read_text())
     assert data["executor"]["kind"] == "local" and "slurm" in data["executor"]
+
+
+@pytest.mark.parametrize(("limit", "seconds"), [("30", 1800), ("05:30", 330), ("02:00:00", 7200),
+                                                ("1-00:00:00", 86400), ("1-2", 93600),
+                                                ("1-02:30", 95400)])
+def test_slurm_time_limits_in_seconds(limit: str, seconds: int) -> None:
+    # sbatch --time: "minutes", "minutes:seconds", "hours:minutes:seconds", "days-hours",
+    # "days-hours:minutes", "days-hours:minutes:seconds".
+    assert time_limit_seconds(limit) == seconds
