@@ -24,7 +24,7 @@ from drumflow.cli_cooler.drum import drum as plant
 from drumflow.cli_export import export
 from drumflow.cli_guard import cli_console, guard_every_command
 from drumflow.cli_paper import paper
-from drumflow.cli_progress import StageProgress
+from drumflow.cli_progress import StageProgress, resume_hint
 from drumflow.cli_sweep import sweep
 
 app = typer.Typer(
@@ -75,19 +75,6 @@ def check(case_file: Annotated[Path, typer.Argument(help="case file (TOML)")]) -
     console.print(table)
 
 
-def _resume_point(out: Path) -> str:
-    """Where a resume of the run in ``out`` starts, for the interrupt message ('' if unknown)."""
-    from drumflow.analysis.run_status import run_status
-
-    try:
-        status = run_status(out)
-    except Exception:  # an interrupt before the run directory was complete: say nothing more
-        return ""
-    if status.restart_time_s is None:
-        return " (no restart yet: it starts again from 0 s)"
-    return f" (from its restart at {status.restart_time_s:.4g} s, step {status.restart_step:,})"
-
-
 @app.command()
 def run(
     case_file: Annotated[Path, typer.Argument(help="case file (TOML)")],
@@ -110,7 +97,7 @@ def run(
             summary = run_case(case, out, processes=np_, steps=steps, timeout=timeout,
                                progress=progress, force=force)
     except KeyboardInterrupt:
-        err_console.print(f"run the same command again to resume into {out}{_resume_point(out)}")
+        err_console.print(resume_hint(out))
         raise
     _print_summary(summary, out, as_json)
     if summary.get("status", "ok") != "ok":

@@ -23,7 +23,7 @@ from rich.markup import escape
 from rich.table import Table
 
 from drumflow.cli_guard import cli_console
-from drumflow.cli_progress import StageProgress
+from drumflow.cli_progress import StageProgress, resume_hint
 from drumflow.errors import CaseError, DrumflowError
 
 console = cli_console()
@@ -78,7 +78,7 @@ def _run_model(case_file: Path, out: Path, processes: int | None) -> None:
         with StageProgress(err_console, prefix=f"{case.name} ") as progress:
             summary = run_case(case, out, processes=processes, progress=progress)
     except KeyboardInterrupt:
-        err_console.print(f"run the same command again to resume into {out}")
+        err_console.print(resume_hint(out))
         raise
     if summary.get("status", "ok") != "ok":
         err_console.print(f"[bold red]{case.name}: {summary['status']}[/] (see {out}/summary.json)")

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
+from pathlib import Path
 from types import TracebackType
 
 from rich.console import Console
@@ -23,7 +24,7 @@ from rich.progress import (
     TimeRemainingColumn,
 )
 
-__all__ = ["PLAIN_EVERY_S", "StageProgress"]
+__all__ = ["PLAIN_EVERY_S", "StageProgress", "resume_hint"]
 
 #: Wall seconds between two plain progress lines of one stage.
 PLAIN_EVERY_S = 60.0
@@ -122,3 +123,18 @@ class StageProgress:
             self.console.print(text, highlight=False, markup=False, soft_wrap=True)
         if ended:
             self._ended.add(stage)
+
+
+def resume_hint(out: Path) -> str:
+    """What to do after an interrupted run in ``out``, and where its resume starts."""
+    from drumflow.analysis.run_status import run_status
+
+    where = ""
+    try:
+        status = run_status(out)
+    except Exception:  # interrupted before the run directory was complete: say nothing more
+        status = None
+    if status is not None:
+        where = (" (no restart yet: it starts again from 0 s)" if status.restart_time_s is None else
+                 f" (from its restart at {status.restart_time_s:.4g} s, step {status.restart_step:,})")
+    return f"run the same command again to resume into {out}{where}"
