@@ -3,6 +3,7 @@
 How to use::
 
     .venv/bin/python scripts/replicate_error.py FIRST SECOND OUT_DIR [--until T] [--window 0.5]
+                                                [--progress]
 
 FIRST and SECOND are run directories (or shipped results folders, see
 ``scripts/ship_paper_run.py``) of the same case (same physics; the launch, the processor grid
@@ -16,9 +17,11 @@ chaotically). Compared over the output times both reached, up to ``--until``:
   (its own timing of each update, paused updates left out; NaN where no update logged one).
 
 Written: OUT_DIR/replicate.csv (one row per window) and OUT_DIR/replicate.json (the summary and
-both runs' sources). The difference of two replicates is the noise floor of a comparison: what
-chaos and round-off alone move. The wall rates are each run's own: two runs on one machine at
-different times are not a side-by-side speed ratio.
+both runs' sources). With ``--progress``, also OUT_DIR/progress.csv: the same windows for the
+SECOND run alone over everything it has reached (a run still going past the first's end). The
+difference of two replicates is the noise floor of a comparison: what chaos and round-off alone
+move. The wall rates are each run's own: two runs on one machine at different times are not a
+side-by-side speed ratio.
 """
 
 from __future__ import annotations
@@ -118,6 +121,31 @@ def compare(first: Path, second: Path, until: float, window: float) -> tuple[pd.
     return pd.DataFrame(rows), summary
 
 
+def progress(run: Path, window: float) -> pd.DataFrame:
+    """One run alone, per window of ``window`` s over its whole length: the mean temperature at
+    the window's end, the crossings (count and falling mass flow, kg/s) and the wall seconds per
+    simulated second."""
+    case = load_case(run / "case.toml")
+    mass = case.dem_case().particles.mass
+    series = _series(run)
+    end = float(series["time_s"].iloc[-1])
+    edges = np.arange(0.0, end + 1e-9, window)
+    if edges[-1] < end - 1e-9:
+        edges = np.append(edges, end)
+    crossings = _crossings(run)
+    time_step = float(json.loads((run / "manifest.json").read_text())["time_step"]["time_step"])
+    wall = _wall_per_window(run, time_step, edges)
+    rows = []
+    for i, (lo, hi) in enumerate(zip(edges[:-1], edges[1:], strict=True)):
+        count = int(((crossings >= lo) & (crossings < hi)).sum())
+        at = series[series["time_s"] <= hi + 1e-9].iloc[-1]
+        rows.append({"window_start_s": lo, "window_end_s": hi,
+                     "temperature_C": float(at["mean_temperature_C"]), "crossings": count,
+                     "falling_mass_flow_kg_s": count * mass / (hi - lo),
+                     "wall_s_per_simulated_s": wall[i]})
+    return pd.DataFrame(rows)
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("first", type=Path)
@@ -125,15 +153,21 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("out", type=Path)
     parser.add_argument("--until", type=float, default=math.inf, help="compare up to this time, s")
     parser.add_argument("--window", type=float, default=0.5, help="window length, s")
+    parser.add_argument("--progress", action="store_true",
+                        help="also write progress.csv: the second run alone over all it reached")
     args = parser.parse_args(argv)
     try:
         table, summary = compare(args.first, args.second, args.until, args.window)
+        ahead = progress(args.second, args.window) if args.progress else None
     except (DrumflowError, OSError, KeyError, ValueError) as exc:
         sys.stderr.write(f"error: {exc}\n")
         return exit_code(exc) if isinstance(exc, DrumflowError) else 2
     args.out.mkdir(parents=True, exist_ok=True)
     table.to_csv(args.out / "replicate.csv", index=False, float_format="%.6g")
     (args.out / "replicate.json").write_text(json.dumps(summary, indent=2))
+    if ahead is not None:
+        ahead.to_csv(args.out / "progress.csv", index=False, float_format="%.6g")
+        print(ahead.to_string(index=False))
     print(table.to_string(index=False))
     print(json.dumps(summary, indent=2))
     return 0

@@ -55,3 +55,22 @@ def test_runs_of_different_cases_are_refused(tmp_path: Path) -> None:
     # The parcel run differs in particles.coarse_grain: not a replicate.
     assert _script().main([str(SHIPPED), str(PARCELS), str(tmp_path / "out")]) == 2
     assert not (tmp_path / "out").exists()
+
+
+def test_progress_of_one_run_over_all_it_reached(tmp_path: Path) -> None:
+    script = _script()
+    ahead = script.progress(SHIPPED, 0.5)
+    series = pd.read_csv(SHIPPED / "post" / "mean_temperature.csv")
+    crossings = pd.read_csv(SHIPPED / "post" / "crossings.csv")
+    # Windows to the run's last output (3.515 s), the last one short.
+    assert ahead["window_end_s"].iloc[-1] == pytest.approx(series["time_s"].iloc[-1])
+    assert len(ahead) == 8
+    # Every crossing counted once, and the flow is the count's mass per window length.
+    assert ahead["crossings"].sum() == (crossings["time"] < series["time_s"].iloc[-1]).sum()
+    mass = ahead["falling_mass_flow_kg_s"] * (ahead["window_end_s"] - ahead["window_start_s"])
+    per_crossing = mass[ahead["crossings"] > 0] / ahead["crossings"][ahead["crossings"] > 0]
+    assert per_crossing.max() == pytest.approx(per_crossing.min())
+    assert ahead["temperature_C"].iloc[-1] == pytest.approx(series["mean_temperature_C"].iloc[-1])
+    out = tmp_path / "out"
+    assert script.main([str(SHIPPED), str(SHIPPED), str(out), "--until", "2.0", "--progress"]) == 0
+    assert len(pd.read_csv(out / "progress.csv")) == 8 and len(pd.read_csv(out / "replicate.csv")) == 4
