@@ -63,3 +63,19 @@ def test_a_variant_with_the_baseline_step_keeps_the_coefficients() -> None:
     skin = next(v for v in VARIANTS if v.name == "skin_x2")
     edited = apply_variant(deck + "neighbor        0.004 bin\n", skin, 2, case)
     assert _coefficients(edited) == (0.1205, 0.313)
+
+
+def test_the_calibration_is_exact_at_the_typical_speed_and_too_elastic_below_it() -> None:
+    """The README's table (model one): calibrated at half the free-fall speed, the default step
+    realises e_pp = 0.1 there but 0.1105 at the bed's median impact (0.14 m/s), the half step
+    0.1049. If the calibration speed changes, this and the README change together."""
+    case = load_case(ROOT / "cases" / "paper_model_one.toml")
+    _, plan = plan_run(case)
+    m, r, e = pair_properties(case, False)
+    speed = typical_impact_velocity(case)
+    assert speed == pytest.approx(0.5 * (2 * 9.81 * case.drum.diameter) ** 0.5, rel=1e-3)
+    for factor, at_median in ((1.0, 0.1105), (0.5, 0.1049)):
+        dt = factor * plan.time_step
+        given = calibrate_case(case, dt)["particle_particle"].liggghts_value
+        assert mean_realised_restitution(given, dt, m, r, e, speed) == pytest.approx(0.1, rel=1e-4)
+        assert mean_realised_restitution(given, dt, m, r, e, 0.14) == pytest.approx(at_median, abs=5e-4)
