@@ -44,6 +44,7 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pandas as pd
 
 from drumflow.bench.profile import profile_run
@@ -56,6 +57,8 @@ from drumflow.coupling.spec import (
     loop_heat_options,
 )
 from drumflow.dem.deck import processors_grid
+from drumflow.dem.dumps import dump_files, dump_step, read_dump
+from drumflow.dem.impacts import approaching_pairs, weighted_quantiles
 from drumflow.dem.restitution import calibrate_case
 from drumflow.dem.stage import DemInputs, finished_loop, latest_restart, write_deck
 from drumflow.dem.thermo import read_thermo
@@ -108,6 +111,10 @@ class Variant:
     overlap_every_row
         The overlap column evaluated on every thermo row, as before the coupling loop left it
         out of most (``overlap_every``).
+    bed_restitution
+        The restitution calibrated at the median particle-particle impact speed measured in the
+        run's last snapshot at or before the restart (:func:`bed_impact_speed`), instead of the
+        typical speed (half the free-fall speed): exact for the impacts the bed has.
     """
 
     name: str
@@ -122,6 +129,7 @@ class Variant:
     no_conduction: bool = False
     no_overlap: bool = False
     overlap_every_row: bool = False
+    bed_restitution: bool = False
 
 
 #: What is compared. The deck's own settings are the baseline: ``neighbor SKIN bin`` (half a
@@ -158,6 +166,12 @@ VARIANTS: list[Variant] = [
     Variant("half_step", "half the time step (20 steps per contact), the static shell",
             time_step_factor=0.5),
     Variant("moving_shell", "the moving-mesh shell, the default time step", moving_shell=True),
+    # The restitution calibrated where the bed's impacts are, at both steps: does the step still
+    # move the bed then?
+    Variant("bed_restitution", "restitution calibrated at the bed's median impact speed",
+            bed_restitution=True),
+    Variant("half_step_bed_restitution", "half the time step, restitution calibrated at the bed's "
+            "median impact speed", time_step_factor=0.5, bed_restitution=True),
     Variant("conservative_grid_x", "conservative, on the processor grid across the drum (x)",
             time_step_factor=0.5, moving_shell=True, processors="{np} 1 1", min_ranks=2),
 ]
@@ -188,9 +202,10 @@ def _scale_value(deck: str, keyword: str, factor: float, fmt: str, suffix: str =
     return _replace_line(deck, rf"^{keyword}\s+.*$", f"{keyword:<16}{value}")
 
 
-def apply_variant(deck: str, variant: Variant, ranks: int, case: Case) -> str:
+def apply_variant(deck: str, variant: Variant, ranks: int, case: Case,
+                  bed_speed: float | None = None) -> str:
     """The baseline deck with the variant's settings; ``case`` calibrates the restitution of a
-    variant with another time step."""
+    variant with another time step, at ``bed_speed`` (m/s) for a ``bed_restitution`` variant."""
     if variant.skin_factor != 1.0:
         deck = _scale_value(deck, "neighbor", variant.skin_factor, "{:.6g} bin", suffix=r"\s+bin")
     if variant.neigh_modify is not None:
@@ -205,6 +220,11 @@ def apply_variant(deck: str, variant: Variant, ranks: int, case: Case) -> str:
                              f"processors      {variant.processors.format(np=ranks)}")
     if variant.time_step_factor != 1.0:
         deck = _scale_value(deck, "timestep", variant.time_step_factor, "{:.12g}")
+    if variant.bed_restitution:
+        if bed_speed is None:
+            raise SettingsStudyError(f"variant {variant.name}: no measured impact speed of the bed")
+        deck = _restitution_at(deck, case, bed_speed)
+    elif variant.time_step_factor != 1.0:
         deck = _restitution_at(deck, case)
     if variant.moving_shell:
         pattern = (r"^fix shell all mesh/surface file (\S+) type 2 surface_ang_vel origin (\S+ \S+ \S+) "
@@ -240,20 +260,38 @@ def apply_variant(deck: str, variant: Variant, ranks: int, case: Case) -> str:
     return deck
 
 
-def _restitution_at(deck: str, case: Case) -> str:
+def _restitution_at(deck: str, case: Case, speed: float | None = None) -> str:
     """The deck's restitution coefficients calibrated for its (new) time step, as a run at that
-    step has them (drumflow.dem.restitution): LIGGGHTS' realised restitution depends on the steps
-    per contact, so the baseline's coefficients at half the step realise e_pp 0.111 instead of
-    the case's 0.1 (paper model one)."""
+    step has them (drumflow.dem.restitution), exact at ``speed`` (default: the typical speed):
+    LIGGGHTS' realised restitution depends on the steps per contact, so the baseline's
+    coefficients at half the step realise e_pp 0.111 instead of the case's 0.1 (paper model one)."""
     m = re.search(r"^timestep\s+(\S+)\s*$", deck, flags=re.M)
     if m is None:
         raise SettingsStudyError("deck: no `timestep` line")
-    calibrated = calibrate_case(case, float(m.group(1)))
+    calibrated = calibrate_case(case, float(m.group(1)), speed)
     e_pp = f"{calibrated['particle_particle'].liggghts_value:.6g}"
     e_pw = f"{calibrated['particle_wall'].liggghts_value:.6g}"
     return _replace_line(deck, r"^fix m3 all property/global coefficientRestitution .*$",
                          "fix m3 all property/global coefficientRestitution peratomtypepair 2 "
                          f"{e_pp} {e_pw} {e_pw} {e_pw}")
+
+
+def bed_impact_speed(rundir: RunDir, restart_step: int, case: Case) -> tuple[float, int]:
+    """The median particle-particle impact speed (m/s) in the run's last snapshot at or before
+    ``restart_step``, and that snapshot's step: pairs closing within a tenth of a diameter,
+    weighted by closing speed (a rate of impacts; :mod:`drumflow.dem.impacts`)."""
+    files = [f for f in dump_files(rundir.dem_dumps, "snap") if dump_step(f) <= restart_step]
+    if not files:
+        raise SettingsStudyError(f"{rundir.dem_dumps}: no snapshot at or before step {restart_step} "
+                                 "to measure the bed's impact speeds")
+    snap = read_dump(files[-1])
+    cols = snap.columns
+    sample = approaching_pairs(np.column_stack([cols["x"], cols["y"], cols["z"]]),
+                               np.column_stack([cols["vx"], cols["vy"], cols["vz"]]),
+                               cols["radius"], 0.1 * case.particles.diameter)
+    if len(sample) == 0:
+        raise SettingsStudyError(f"{files[-1]}: no particles about to collide")
+    return float(weighted_quantiles(sample.speed, sample.weight, [0.5])[0]), snap.step
 
 
 def variant_steps(steps: int, variant: Variant) -> int:
@@ -493,6 +531,10 @@ def run_settings_study(case: Case, run_dir: Path, out: Path, steps: int = 400, r
     meta: dict[str, Any] = {"run_dir": str(rundir.root.resolve()), "restart": str(restart),
                             "restart_step": start, "steps": steps, "ranks": ranks}
     earlier = _earlier_rows(out, meta)
+    bed_speed = None
+    if any(v.bed_restitution for v in variants):
+        bed_speed, snapshot_step = bed_impact_speed(rundir, start, case.dem_case())
+        meta["bed_impact_speed"] = {"median_m_s": bed_speed, "snapshot_step": snapshot_step}
     runner = Runner()
     meta.update(deck=deck_source, variants=[asdict(v) for v in variants],
                 tolerances={"temperature_of_change": TEMPERATURE_TOLERANCE,
@@ -531,8 +573,9 @@ def run_settings_study(case: Case, run_dir: Path, out: Path, steps: int = 400, r
                 on_variant(variant, index, len(variants), None)
             folder = scratch / variant.name
             n_steps = variant_steps(steps, variant)
-            _prepare(folder, rundir, restart, apply_variant(deck, variant, ranks, case.dem_case()), driver,
-                     start + n_steps, variant.time_step_factor, start, variant.no_conduction,
+            edited = apply_variant(deck, variant, ranks, case.dem_case(), bed_speed)
+            _prepare(folder, rundir, restart, edited, driver, start + n_steps,
+                     variant.time_step_factor, start, variant.no_conduction,
                      overlap_every_row=variant.overlap_every_row or variant.no_overlap)
             t0 = time.perf_counter()
             try:

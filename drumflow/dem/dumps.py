@@ -122,6 +122,11 @@ def _read_packed(path: Path) -> Snapshot:
     return Snapshot(step, columns)
 
 
+def dump_step(path: Path) -> int:
+    """The time step a dump file's name carries (``snap.<step>.txt`` or ``.npz``); -1 if none."""
+    return _step_of(path)
+
+
 def _step_of(p: Path) -> int:
     m = _STEP_RE.findall(p.name)
     return int(m[-1]) if m else -1

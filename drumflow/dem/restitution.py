@@ -182,15 +182,19 @@ def pair_properties(case: Case, wall: bool) -> tuple[float, float, float]:
     return 0.5 * mass, 0.5 * p.radius, p.youngs_modulus / (2.0 * (1.0 - p.poisson_ratio**2))
 
 
-def calibrate_case(case: Case, time_step: float) -> dict[str, RestitutionCalibration]:
+def calibrate_case(case: Case, time_step: float,
+                   speed: float | None = None) -> dict[str, RestitutionCalibration]:
     """Calibrated coefficients of the case's two contact pairs at ``time_step``.
 
     Keys ``particle_particle`` and ``particle_wall``. With ``run.restitution_correction``
     off, each coefficient is passed through unchanged (and the record shows what it realises).
+    ``speed`` is the impact speed the calibration is exact at (m/s; default the scene's typical
+    speed, :func:`drumflow.dem.timestep.typical_impact_velocity`).
     """
     from drumflow.dem.timestep import typical_impact_velocity
 
-    speed = typical_impact_velocity(case)
+    if speed is None:
+        speed = typical_impact_velocity(case)
     out: dict[str, RestitutionCalibration] = {}
     for name, wall in (("particle_particle", False), ("particle_wall", True)):
         target = getattr(case.contacts, name).restitution
