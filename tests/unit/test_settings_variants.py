@@ -13,6 +13,7 @@ from drumflow.case import load_case
 from drumflow.dem.restitution import calibrate_case, mean_realised_restitution, pair_properties
 from drumflow.dem.stage import plan_run
 from drumflow.dem.timestep import typical_impact_velocity
+from drumflow.errors import SettingsStudyError
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -79,3 +80,19 @@ def test_the_calibration_is_exact_at_the_typical_speed_and_too_elastic_below_it(
         given = calibrate_case(case, dt)["particle_particle"].liggghts_value
         assert mean_realised_restitution(given, dt, m, r, e, speed) == pytest.approx(0.1, rel=1e-4)
         assert mean_realised_restitution(given, dt, m, r, e, 0.14) == pytest.approx(at_median, abs=5e-4)
+
+
+def test_a_bed_restitution_variant_is_exact_at_the_bed_speed() -> None:
+    case = load_case(ROOT / "cases" / "paper_model_one.toml")
+    _, plan = plan_run(case)
+    base = calibrate_case(case, plan.time_step)
+    deck = _deck(plan.time_step, base["particle_particle"].liggghts_value,
+                 base["particle_wall"].liggghts_value)
+    m, r, e = pair_properties(case, False)
+    for name, dt in (("bed_restitution", plan.time_step),
+                     ("half_step_bed_restitution", 0.5 * plan.time_step)):
+        variant = next(v for v in VARIANTS if v.name == name)
+        with pytest.raises(SettingsStudyError, match="no measured impact speed"):
+            apply_variant(deck, variant, 2, case)
+        e_pp, _ = _coefficients(apply_variant(deck, variant, 2, case, bed_speed=0.14))
+        assert mean_realised_restitution(e_pp, dt, m, r, e, 0.14) == pytest.approx(0.1, rel=1e-4)
