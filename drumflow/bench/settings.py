@@ -115,6 +115,9 @@ class Variant:
         The restitution calibrated at the median particle-particle impact speed measured in the
         run's last snapshot at or before the restart (:func:`bed_impact_speed`), instead of the
         typical speed (half the free-fall speed): exact for the impacts the bed has.
+    no_rolling_friction
+        Rolling friction coefficients 0 (a diagnostic that changes the physics: what the
+        constant-directional-torque model contributes to a difference between settings).
     """
 
     name: str
@@ -130,6 +133,7 @@ class Variant:
     no_overlap: bool = False
     overlap_every_row: bool = False
     bed_restitution: bool = False
+    no_rolling_friction: bool = False
 
 
 #: What is compared. The deck's own settings are the baseline: ``neighbor SKIN bin`` (half a
@@ -172,6 +176,10 @@ VARIANTS: list[Variant] = [
             bed_restitution=True),
     Variant("half_step_bed_restitution", "half the time step, restitution calibrated at the bed's "
             "median impact speed", time_step_factor=0.5, bed_restitution=True),
+    # ...and without rolling friction at both steps (diagnostic: changes the physics).
+    Variant("no_rolling_friction", "rolling friction off (diagnostic)", no_rolling_friction=True),
+    Variant("half_step_no_rolling_friction", "half the time step, rolling friction off (diagnostic)",
+            time_step_factor=0.5, no_rolling_friction=True),
     Variant("conservative_grid_x", "conservative, on the processor grid across the drum (x)",
             time_step_factor=0.5, moving_shell=True, processors="{np} 1 1", min_ranks=2),
 ]
@@ -226,6 +234,10 @@ def apply_variant(deck: str, variant: Variant, ranks: int, case: Case,
         deck = _restitution_at(deck, case, bed_speed)
     elif variant.time_step_factor != 1.0:
         deck = _restitution_at(deck, case)
+    if variant.no_rolling_friction:
+        deck = _replace_line(deck, r"^fix m5 all property/global coefficientRollingFriction .*$",
+                             "fix m5 all property/global coefficientRollingFriction peratomtypepair 2 "
+                             "0 0 0 0")
     if variant.moving_shell:
         pattern = (r"^fix shell all mesh/surface file (\S+) type 2 surface_ang_vel origin (\S+ \S+ \S+) "
                    r"axis (\S+ \S+ \S+) omega (\S+)\s*$")
