@@ -5,8 +5,10 @@ after writing its restart), and one that never looks (killed after the grace).""
 from __future__ import annotations
 
 import _thread
+import signal
 import sys
 import threading
+from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -19,9 +21,11 @@ _WATCHER = """
 import pathlib, sys, time
 request, done = pathlib.Path(sys.argv[1]), pathlib.Path(sys.argv[2])
 print("ready", flush=True)
-while not request.exists():
+deadline = time.time() + 60  # never hang a test run
+while not request.exists() and time.time() < deadline:
     time.sleep(0.05)
-done.write_text("restart written")
+if request.exists():
+    done.write_text("restart written")
 """
 
 _DEAF = """
@@ -29,6 +33,18 @@ import time
 print("ready", flush=True)
 time.sleep(60)
 """
+
+
+@pytest.fixture(autouse=True)
+def _ctrl_c_raises() -> Iterator[None]:
+    """Ctrl-C raises KeyboardInterrupt in these tests, whatever the test process inherited: a
+    background job (`cmd &` from a script, as CI may be) starts with SIGINT ignored, and then
+    `_thread.interrupt_main` does nothing and the runner would wait for ever."""
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
 
 
 def _interrupt_when_ready(log: Path) -> threading.Thread:
