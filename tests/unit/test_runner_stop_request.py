@@ -15,12 +15,13 @@ import pytest
 
 from drumflow.runner import Runner
 
-#: A stand-in for the coupling loop's side of the protocol: it says it is ready, polls for the
-#: request as the loop does at every air update, then "writes its restart" and exits 0.
+#: A stand-in for the coupling loop's side of the protocol: it says it is ready (a marker file:
+#: the runner's log is not flushed line by line), polls for the request as the loop does at every
+#: air update, then "writes its restart" and exits 0.
 _WATCHER = """
 import pathlib, sys, time
 request, done = pathlib.Path(sys.argv[1]), pathlib.Path(sys.argv[2])
-print("ready", flush=True)
+pathlib.Path(sys.argv[3]).write_text("ready")
 deadline = time.time() + 60  # never hang a test run
 while not request.exists() and time.time() < deadline:
     time.sleep(0.05)
@@ -29,8 +30,8 @@ if request.exists():
 """
 
 _DEAF = """
-import time
-print("ready", flush=True)
+import pathlib, sys, time
+pathlib.Path(sys.argv[1]).write_text("ready")
 time.sleep(60)
 """
 
@@ -47,12 +48,16 @@ def _ctrl_c_raises() -> Iterator[None]:
         signal.signal(signal.SIGINT, previous)
 
 
-def _interrupt_when_ready(log: Path) -> threading.Thread:
-    """Ctrl-C in the main thread once the child has printed 'ready' (at most 20 s)."""
+def _interrupt_when_ready(ready: Path) -> threading.Thread:
+    """Ctrl-C in the main thread once the child has written its ``ready`` marker (at most 20 s).
+
+    Regression: this used to look for 'ready' in the runner's log, whose header repeats the
+    command and so the stand-in's source; the interrupt could then come before the program had
+    started, and no stop was requested (CI of stop 24 failed that way)."""
 
     def fire() -> None:
         for _ in range(400):
-            if log.exists() and "ready" in log.read_text():
+            if ready.exists():
                 break
             threading.Event().wait(0.05)
         _thread.interrupt_main()
@@ -66,9 +71,10 @@ def test_an_interrupt_asks_the_program_to_stop_and_waits_for_it(tmp_path: Path) 
     request, done, log = tmp_path / "stop.request", tmp_path / "restart", tmp_path / "out.log"
     request.write_text("stale, from an earlier attempt")
     runner = Runner()
-    _interrupt_when_ready(log)
+    _interrupt_when_ready(tmp_path / "ready")
     with pytest.raises(KeyboardInterrupt):
-        runner.run("watcher", [sys.executable, "-c", _WATCHER, str(request), str(done)], tmp_path,
+        runner.run("watcher", [sys.executable, "-c", _WATCHER, str(request), str(done),
+                               str(tmp_path / "ready")], tmp_path,
                    log, stop_request=request, stop_grace=30.0)
     # The stale request was removed before the start (else the program would have stopped at
     # once, before 'ready'), the new one written on the interrupt, and the program ended by
@@ -81,18 +87,20 @@ def test_an_interrupt_asks_the_program_to_stop_and_waits_for_it(tmp_path: Path) 
 def test_without_a_request_file_the_program_is_killed_at_once(tmp_path: Path) -> None:
     request, done, log = tmp_path / "stop.request", tmp_path / "restart", tmp_path / "out.log"
     runner = Runner()
-    _interrupt_when_ready(log)
+    _interrupt_when_ready(tmp_path / "ready")
     with pytest.raises(KeyboardInterrupt):
-        runner.run("watcher", [sys.executable, "-c", _WATCHER, str(request), str(done)], tmp_path, log)
+        runner.run("watcher", [sys.executable, "-c", _WATCHER, str(request), str(done),
+                               str(tmp_path / "ready")], tmp_path, log)
     assert not request.exists() and not done.exists()
 
 
 def test_a_program_that_does_not_stop_is_killed_after_the_grace(tmp_path: Path) -> None:
     request, log = tmp_path / "stop.request", tmp_path / "out.log"
     runner = Runner()
-    _interrupt_when_ready(log)
+    _interrupt_when_ready(tmp_path / "ready")
     with pytest.raises(KeyboardInterrupt):
-        runner.run("deaf", [sys.executable, "-c", _DEAF], tmp_path, log, stop_request=request,
+        runner.run("deaf", [sys.executable, "-c", _DEAF, str(tmp_path / "ready")], tmp_path, log,
+                   stop_request=request,
                    stop_grace=0.5)
     record = runner.records[-1]
     assert request.exists() and record.status == "interrupted"
