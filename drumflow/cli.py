@@ -163,7 +163,13 @@ def stop(
         raise RunDirectoryError(f"{run_dir}: no run is going there ({state}); allowed: the "
                                 "directory of a running `drumflow run`")
     request = request_stop(run_dir)
-    err_console.print(f"asked the run in {run_dir} to stop at its next air update ({request.name})")
+    if st.reached_time_s is None:
+        # Geometry and air are not interrupted: the air solve is kept and the DEM stops at its
+        # first air update with a restart, so the next `drumflow run` loses nothing.
+        err_console.print(f"asked the run in {run_dir} to stop: its DEM has not started, so it "
+                          f"stops at the DEM's first air update ({request.name})")
+    else:
+        err_console.print(f"asked the run in {run_dir} to stop at its next air update ({request.name})")
     if not wait:
         return
     deadline = time.monotonic() + timeout

@@ -32,7 +32,13 @@ from drumflow.coupling.log import heat_removed_until, read_coupling
 from drumflow.coupling.spec import CouplingSpec, build_coupling
 from drumflow.coupling.stop import STOP_RECORD
 from drumflow.dem.dumps import read_rows, read_series
-from drumflow.dem.stage import DemInputs, DemResult, ProgressCallback, plan_run
+from drumflow.dem.stage import (
+    DemInputs,
+    DemResult,
+    ProgressCallback,
+    clear_stop_request,
+    plan_run,
+)
 from drumflow.dem.thermo import read_thermo
 from drumflow.errors import CaseError, RunDirectoryError
 from drumflow.report.plots import (
@@ -102,6 +108,8 @@ def run_case(
     # Who runs in this directory: `drumflow status` tells a live run from one that was killed.
     rundir.record("process", {"pid": os.getpid(), "host": socket.gethostname(),
                               "started": time.time()})
+    # A stop request of an earlier attempt is stale; one made from now on is kept for the DEM.
+    clear_stop_request(rundir)
     t0 = time.perf_counter()
     # What the DEM moves: the particles, or with particles.coarse_grain their parcels. Geometry,
     # time step and DEM follow the parcels; the air and its coupling the real particles.

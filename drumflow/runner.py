@@ -263,7 +263,9 @@ class Runner:
             A file the program looks for to stop cleanly (the coupling loop writes a restart,
             then exits). On an interrupt the runner writes it and gives the program
             ``stop_grace`` seconds to end before killing its process group; the interrupt is
-            raised either way. A stale request is removed before the program starts.
+            raised either way. A request already there when the program starts is left for
+            it (``drumflow stop`` while earlier stages ran): the caller removes stale ones at
+            the start of its attempt.
         stop_grace
             Seconds allowed for that clean stop.
 
@@ -283,8 +285,6 @@ class Runner:
         full_env = {**os.environ, **self.profile.env, **(env or {})}
         record = RunRecord(program, command, str(cwd), str(log), None, 0.0, time.time())
         self.records.append(record)
-        if stop_request is not None:
-            stop_request.unlink(missing_ok=True)
         with log.open("w", encoding="utf-8", errors="replace") as fh:
             fh.write(f"# drumflow runner: {' '.join(command)}\n# cwd: {cwd}\n")
             fh.flush()

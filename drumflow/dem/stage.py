@@ -20,6 +20,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from drumflow.case import load_case
 from drumflow.coupling.spec import (
     COUPLING_FILE,
     STOP_REQUEST,
@@ -66,7 +67,8 @@ if TYPE_CHECKING:
     from drumflow.rundir import RunDir
     from drumflow.runner import Runner
 
-__all__ = ["DemInputs", "DemResult", "ProgressCallback", "dem_key", "plan_run", "request_stop", "run"]
+__all__ = ["DemInputs", "DemResult", "ProgressCallback", "clear_stop_request", "dem_key", "plan_run",
+           "request_stop", "run"]
 
 #: progress(stage, done, total): simulated seconds done out of the total.
 ProgressCallback = Callable[[str, float, float], None]
@@ -182,7 +184,8 @@ def _stage_key(case: Case, inputs: DemInputs) -> str:
 def request_stop(run_dir: Path) -> Path:
     """Ask the coupling loop running in ``run_dir`` to write a restart at its next air update and
     stop (``drumflow stop``); return the request file. ``drumflow run`` then exits with 130 and
-    resumes from that restart when run again.
+    resumes from that restart when run again. A run still in its geometry or air stage keeps
+    the request and stops at its DEM's first air update.
 
     Raises
     ------
@@ -192,7 +195,13 @@ def request_stop(run_dir: Path) -> Path:
     """
     dem_dir = Path(run_dir) / "dem"
     spec = dem_dir / COUPLING_FILE
-    if not spec.is_file() or not json.loads(spec.read_text()).get("checkpoint"):
+    if spec.is_file():
+        stoppable = bool(json.loads(spec.read_text()).get("checkpoint"))
+    else:
+        # The DEM stage has not started: the case says whether it will have a loop.
+        case_file = Path(run_dir) / "case.toml"
+        stoppable = case_file.is_file() and load_case(case_file).air.model != "none"
+    if not stoppable:
         raise RunDirectoryError(
             f"{Path(run_dir).resolve()}: its DEM run cannot be asked to stop (allowed: a run with "
             "air, air.model 'uniform' or 'cfd', started by this drumflow); stop it with Ctrl-C or "
@@ -200,6 +209,12 @@ def request_stop(run_dir: Path) -> Path:
     request = dem_dir / STOP_REQUEST
     request.write_text(f"stop requested at {time.strftime('%Y-%m-%d %H:%M:%S')} (drumflow stop)\n")
     return request
+
+
+def clear_stop_request(rundir: RunDir) -> None:
+    """Remove a stop request left by an earlier attempt (``drumflow run`` calls this when it
+    starts, so a request made while this attempt's geometry or air stage runs is kept)."""
+    (rundir.dem / STOP_REQUEST).unlink(missing_ok=True)
 
 
 def restart_files(folder: Path) -> list[tuple[int, Path]]:
@@ -399,7 +414,9 @@ def _launch(case: Case, rundir: RunDir, runner: Runner, inputs: DemInputs, deck_
         runner.run("liggghts", command, work, log, timeout=inputs.timeout, on_line=watcher,
                    check=finished_loop, follow=own_log, stop_request=stop_request)
         if stopped_record.exists():
-            # `drumflow stop`: the loop wrote a restart and ended before the run's end.
+            # `drumflow stop`: the loop wrote a restart and ended before the run's end; the
+            # manifest says so rather than "ok".
+            runner.records[-1].status = "stopped on request"
             _tidy_output(rundir.dem_restart, rundir.dem_dumps, finished=False)
             where = json.loads(stopped_record.read_text())
             raise RunStoppedError(int(where["step"]), float(where["time_s"]))

@@ -291,6 +291,9 @@ def test_drumflow_stop_stops_a_run_at_a_restart_of_its_own(runs: dict[str, Path]
     assert record["step"] == step and sent["signalled_at_s"] <= record["time_s"] < 0.6
     assert not (runs["asked_to_stop"] / "dem" / "stop.request").exists()  # consumed
     assert not run_status(runs["asked_to_stop"]).running
+    # Regression: the manifest recorded the loop's command as "ok" after a requested stop.
+    manifest = json.loads((runs["asked_to_stop"] / "manifest.json").read_text())
+    assert manifest["commands"][-1]["status"] == "stopped on request"
 
 
 @pytest.mark.parametrize(("run", "uninterrupted"), [("resumed", "straight"), ("checkpointed", "two_ranks")])

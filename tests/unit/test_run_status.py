@@ -20,10 +20,11 @@ import pytest
 from typer.testing import CliRunner
 
 from drumflow.analysis.run_status import LOG_TAIL_BYTES, RECENT_UPDATES, run_status
-from drumflow.case import case_to_toml, load_case
+from drumflow.case import Case, case_to_toml, load_case
 from drumflow.cli import app
-from drumflow.dem.stage import request_stop
+from drumflow.dem.stage import clear_stop_request, request_stop
 from drumflow.errors import MissingRunFileError, RunDirectoryError
+from drumflow.rundir import RunDir
 
 ROOT = Path(__file__).resolve().parents[2]
 DT = 1e-4
@@ -148,14 +149,34 @@ def test_drumflow_stop_refuses_a_run_that_is_not_going(tmp_path: Path) -> None:
 
 def test_a_run_without_a_coupling_loop_cannot_be_asked_to_stop(tmp_path: Path) -> None:
     run = _write_run(tmp_path / "run", last_step=2500, update_walls=[2.0] * 5)
+    with_air = (run / "case.toml").read_text()
+    data = load_case(run / "case.toml").model_dump(mode="json")
+    data["air"]["model"] = "none"
+    (run / "case.toml").write_text(case_to_toml(Case.model_validate(data)))
     with pytest.raises(RunDirectoryError, match="cannot be asked to stop"):
-        request_stop(run)  # no dem/coupling.json: LIGGGHTS alone
+        request_stop(run)  # no dem/coupling.json and no air: LIGGGHTS alone
+    (run / "case.toml").write_text(with_air)
     (run / "dem" / "coupling.json").write_text(json.dumps({"interval": 50}))
     with pytest.raises(RunDirectoryError, match="cannot be asked to stop"):
         request_stop(run)  # a loop without a restart pattern (a study's, a short check's)
     (run / "dem" / "coupling.json").write_text(json.dumps({"checkpoint": "restart/drum.*.restart"}))
     assert request_stop(run) == run / "dem" / "stop.request"
     assert "drumflow stop" in (run / "dem" / "stop.request").read_text()
+
+
+def test_a_stop_asked_before_the_dem_stage_is_kept_for_it(tmp_path: Path) -> None:
+    """Regression: `drumflow stop` during the geometry or air stage was lost (refused for want of
+    dem/coupling.json on a new run, removed at the DEM's start on a resumed one). Now the case
+    decides, the request stays until the loop's first air update, and only the start of the
+    next `drumflow run` attempt removes a stale one."""
+    run = tmp_path / "run"
+    case = load_case(ROOT / "cases" / "smoke.toml")  # air.model = "cfd"
+    (run / "dem").mkdir(parents=True)
+    (run / "case.toml").write_text(case_to_toml(case))
+    request = request_stop(run)
+    assert request == run / "dem" / "stop.request" and request.exists()
+    clear_stop_request(RunDir(run))
+    assert not request.exists()
 
 
 def test_a_run_stopped_on_request_says_so(tmp_path: Path) -> None:

@@ -69,19 +69,28 @@ def _interrupt_when_ready(ready: Path) -> threading.Thread:
 
 def test_an_interrupt_asks_the_program_to_stop_and_waits_for_it(tmp_path: Path) -> None:
     request, done, log = tmp_path / "stop.request", tmp_path / "restart", tmp_path / "out.log"
-    request.write_text("stale, from an earlier attempt")
     runner = Runner()
     _interrupt_when_ready(tmp_path / "ready")
     with pytest.raises(KeyboardInterrupt):
         runner.run("watcher", [sys.executable, "-c", _WATCHER, str(request), str(done),
                                str(tmp_path / "ready")], tmp_path,
                    log, stop_request=request, stop_grace=30.0)
-    # The stale request was removed before the start (else the program would have stopped at
-    # once, before 'ready'), the new one written on the interrupt, and the program ended by
-    # itself after doing its part: the interrupt is still raised, the record says so.
+    # The request was written on the interrupt and the program ended by itself after doing its
+    # part: the interrupt is still raised, the record says so.
     assert done.read_text() == "restart written"
     assert "stop requested" in request.read_text()
     assert runner.records[-1].status == "interrupted"
+
+
+def test_a_request_made_before_the_start_is_left_for_the_program(tmp_path: Path) -> None:
+    """`drumflow stop` while the geometry or air stage ran: the request is already there when
+    the loop starts, and the loop stops at once by itself (the caller removes stale requests)."""
+    request, done = tmp_path / "stop.request", tmp_path / "restart"
+    request.write_text("stop requested while the air stage ran")
+    record = Runner().run("watcher", [sys.executable, "-c", _WATCHER, str(request), str(done),
+                                      str(tmp_path / "ready")], tmp_path, tmp_path / "out.log",
+                          stop_request=request)
+    assert record.status == "ok" and done.read_text() == "restart written"
 
 
 def test_without_a_request_file_the_program_is_killed_at_once(tmp_path: Path) -> None:
