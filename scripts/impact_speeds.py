@@ -43,9 +43,7 @@ POPULATIONS = ("particle-particle", "particle-wall", "all")
 
 
 def _samples(snap_cols: dict[str, np.ndarray], case: Case, gap: float) -> dict[str, ImpactSample]:
-    x = np.column_stack([snap_cols["x"], snap_cols["y"], snap_cols["z"]])
-    v = np.column_stack([snap_cols["vx"], snap_cols["vy"], snap_cols["vz"]])
-    r = snap_cols["radius"]
+    x, v, r = impacts.snapshot_kinematics(snap_cols)
     pp = impacts.approaching_pairs(x, v, r, gap)
     pw = impacts.wall_approaches(x, v, r, gap, case.drum.radius, 0.0, case.drum.length)
     both = impacts.pool([pp, pw], speed_factors=[1.0, WALL_EQUIVALENT_SPEED_FACTOR], instants=1)

@@ -52,6 +52,20 @@ def _crossings(root: Path) -> pd.Series:
     raise FileNotFoundError(f"{root / 'post'}: no crossings.csv")
 
 
+def _time_step(root: Path) -> float:
+    return float(json.loads((root / "manifest.json").read_text())["time_step"]["time_step"])
+
+
+def _window_edges(end: float, window: float) -> np.ndarray:
+    """0, window, 2 window, ... and ``end`` itself when it falls between two of them."""
+    edges = np.arange(0.0, end + 1e-9, window)
+    return np.append(edges, end) if edges[-1] < end - 1e-9 else edges
+
+
+def _count(times: pd.Series, lo: float, hi: float) -> int:
+    return int(((times >= lo) & (times < hi)).sum())
+
+
 def _wall_per_window(root: Path, time_step: float, edges: np.ndarray) -> np.ndarray:
     """Wall seconds per simulated second in each window, from the unpaused logged updates."""
     coupling = read_coupling(root / "dem" / "coupling", time_step)
@@ -85,16 +99,13 @@ def compare(first: Path, second: Path, until: float, window: float) -> tuple[pd.
     t0 = float(merged["mean_temperature_C_a"].iloc[0])
     cooling_a = t0 - float(merged["mean_temperature_C_a"].iloc[-1])
     cooling_b = float(merged["mean_temperature_C_b"].iloc[0]) - float(merged["mean_temperature_C_b"].iloc[-1])
-    time_step = float(json.loads((first / "manifest.json").read_text())["time_step"]["time_step"])
-    time_step_b = float(json.loads((second / "manifest.json").read_text())["time_step"]["time_step"])
-    edges = np.arange(0.0, end + 1e-9, window)
-    if edges[-1] < end - 1e-9:
-        edges = np.append(edges, end)
+    edges = _window_edges(end, window)
     cross_a, cross_b = _crossings(first), _crossings(second)
-    wall_a = _wall_per_window(first, time_step, edges)
-    wall_b = _wall_per_window(second, time_step_b, edges)
+    wall_a = _wall_per_window(first, _time_step(first), edges)
+    wall_b = _wall_per_window(second, _time_step(second), edges)
+
     def flow(times: pd.Series, lo: float, hi: float) -> float:
-        return float(((times >= lo) & (times < hi)).sum()) * mass / (hi - lo)
+        return _count(times, lo, hi) * mass / (hi - lo)
 
     rows = []
     for i, (lo, hi) in enumerate(zip(edges[:-1], edges[1:], strict=True)):
@@ -129,15 +140,12 @@ def progress(run: Path, window: float) -> pd.DataFrame:
     mass = case.dem_case().particles.mass
     series = _series(run)
     end = float(series["time_s"].iloc[-1])
-    edges = np.arange(0.0, end + 1e-9, window)
-    if edges[-1] < end - 1e-9:
-        edges = np.append(edges, end)
+    edges = _window_edges(end, window)
     crossings = _crossings(run)
-    time_step = float(json.loads((run / "manifest.json").read_text())["time_step"]["time_step"])
-    wall = _wall_per_window(run, time_step, edges)
+    wall = _wall_per_window(run, _time_step(run), edges)
     rows = []
     for i, (lo, hi) in enumerate(zip(edges[:-1], edges[1:], strict=True)):
-        count = int(((crossings >= lo) & (crossings < hi)).sum())
+        count = _count(crossings, lo, hi)
         at = series[series["time_s"] <= hi + 1e-9].iloc[-1]
         rows.append({"window_start_s": lo, "window_end_s": hi,
                      "temperature_C": float(at["mean_temperature_C"]), "crossings": count,

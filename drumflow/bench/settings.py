@@ -44,7 +44,6 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
-import numpy as np
 import pandas as pd
 
 from drumflow.bench.profile import profile_run
@@ -58,7 +57,7 @@ from drumflow.coupling.spec import (
 )
 from drumflow.dem.deck import processors_grid
 from drumflow.dem.dumps import dump_files, dump_step, read_dump
-from drumflow.dem.impacts import approaching_pairs, weighted_quantiles
+from drumflow.dem.impacts import approaching_pairs, snapshot_kinematics, weighted_quantiles
 from drumflow.dem.restitution import calibrate_case
 from drumflow.dem.stage import DemInputs, finished_loop, latest_restart, write_deck
 from drumflow.dem.thermo import read_thermo
@@ -235,9 +234,7 @@ def apply_variant(deck: str, variant: Variant, ranks: int, case: Case,
     elif variant.time_step_factor != 1.0:
         deck = _restitution_at(deck, case)
     if variant.no_rolling_friction:
-        deck = _replace_line(deck, r"^fix m5 all property/global coefficientRollingFriction .*$",
-                             "fix m5 all property/global coefficientRollingFriction peratomtypepair 2 "
-                             "0 0 0 0")
+        deck = _pair_property(deck, "m5", "coefficientRollingFriction", "0", "0")
     if variant.moving_shell:
         pattern = (r"^fix shell all mesh/surface file (\S+) type 2 surface_ang_vel origin (\S+ \S+ \S+) "
                    r"axis (\S+ \S+ \S+) omega (\S+)\s*$")
@@ -283,9 +280,16 @@ def _restitution_at(deck: str, case: Case, speed: float | None = None) -> str:
     calibrated = calibrate_case(case, float(m.group(1)), speed)
     e_pp = f"{calibrated['particle_particle'].liggghts_value:.6g}"
     e_pw = f"{calibrated['particle_wall'].liggghts_value:.6g}"
-    return _replace_line(deck, r"^fix m3 all property/global coefficientRestitution .*$",
-                         "fix m3 all property/global coefficientRestitution peratomtypepair 2 "
-                         f"{e_pp} {e_pw} {e_pw} {e_pw}")
+    return _pair_property(deck, "m3", "coefficientRestitution", e_pp, e_pw)
+
+
+def _pair_property(deck: str, fix_id: str, name: str, pp: str, pw: str) -> str:
+    """The deck with its ``fix ID all property/global NAME peratomtypepair 2`` line set to
+    particle-particle ``pp`` and particle-wall ``pw`` (type 1 the particles, 2 the walls, as
+    drum.in.j2 writes them; wall-wall is never used and takes ``pw``)."""
+    return _replace_line(deck, rf"^fix {fix_id} all property/global {name} .*$",
+                         f"fix {fix_id} all property/global {name} peratomtypepair 2 "
+                         f"{pp} {pw} {pw} {pw}")
 
 
 def bed_impact_speed(rundir: RunDir, restart_step: int, case: Case) -> tuple[float, int]:
@@ -297,10 +301,7 @@ def bed_impact_speed(rundir: RunDir, restart_step: int, case: Case) -> tuple[flo
         raise SettingsStudyError(f"{rundir.dem_dumps}: no snapshot at or before step {restart_step} "
                                  "to measure the bed's impact speeds")
     snap = read_dump(files[-1])
-    cols = snap.columns
-    sample = approaching_pairs(np.column_stack([cols["x"], cols["y"], cols["z"]]),
-                               np.column_stack([cols["vx"], cols["vy"], cols["vz"]]),
-                               cols["radius"], 0.1 * case.particles.diameter)
+    sample = approaching_pairs(*snapshot_kinematics(snap.columns), 0.1 * case.particles.diameter)
     if len(sample) == 0:
         raise SettingsStudyError(f"{files[-1]}: no particles about to collide")
     return float(weighted_quantiles(sample.speed, sample.weight, [0.5])[0]), snap.step

@@ -44,7 +44,7 @@ For one snapshot (positions, velocities and radii of every particle at one insta
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Literal
 
@@ -117,6 +117,16 @@ def _as_particles(
 def _sample(speed: NDArray[np.float64], gap_max: float) -> ImpactSample:
     speed = np.ascontiguousarray(speed, dtype=np.float64)
     return ImpactSample(speed=speed, weight=speed.copy(), gap_max=gap_max)
+
+
+def snapshot_kinematics(
+    columns: Mapping[str, NDArray[np.float64]],
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """Centres ``(n, 3)``, velocities ``(n, 3)`` and radii ``(n,)`` from a snapshot's columns
+    (``x y z vx vy vz radius``, as :func:`drumflow.dem.dumps.read_dump` gives them)."""
+    return (np.column_stack([columns["x"], columns["y"], columns["z"]]),
+            np.column_stack([columns["vx"], columns["vy"], columns["vz"]]),
+            np.asarray(columns["radius"], dtype=float))
 
 
 def approaching_pairs(

@@ -15,6 +15,7 @@ from drumflow.dem.impacts import (
     approaching_pairs,
     implied_time_steps,
     pool,
+    snapshot_kinematics,
     wall_approaches,
     weighted_quantiles,
 )
@@ -189,3 +190,17 @@ def test_bad_gap_is_refused() -> None:
     x, v, r = _pair(0.0, np.zeros(3), np.zeros(3), np.array([1.0, 0.0, 0.0]))
     with pytest.raises(AnalysisInputError, match="gap_max = 0"):
         approaching_pairs(x, v, r, 0.0)
+
+
+def test_a_snapshots_columns_give_the_same_pairs_as_the_arrays() -> None:
+    """The snapshot reader's columns (as `drumflow bench --from` and scripts/impact_speeds.py
+    pass them) stack into the centres, velocities and radii the measurement takes."""
+    x, v, r = _pair(0.5 * GAP, np.array([0.3, 0.0, 0.0]), np.array([-0.2, 0.0, 0.0]),
+                    np.array([1.0, 0.0, 0.0]))
+    columns = {"x": x[:, 0], "y": x[:, 1], "z": x[:, 2], "vx": v[:, 0], "vy": v[:, 1],
+               "vz": v[:, 2], "radius": r, "id": np.array([1.0, 2.0])}
+    xs, vs, rs = snapshot_kinematics(columns)
+    np.testing.assert_array_equal(xs, x)
+    np.testing.assert_array_equal(vs, v)
+    np.testing.assert_array_equal(rs, r)
+    assert approaching_pairs(xs, vs, rs, GAP).speed == pytest.approx([0.5])
