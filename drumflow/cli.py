@@ -72,6 +72,12 @@ def check(case_file: Annotated[Path, typer.Argument(help="case file (TOML)")]) -
                   f"of Rayleigh {choice.rayleigh_time:.3g} s; "
                   f"{choice.steps_per_contact:.0f} steps per contact)")
     table.add_row("steps", f"{round(case.run.time / choice.time_step):,} for {case.run.time:g} s")
+    if choice.spin_time_step_limit is not None:
+        ratio = choice.time_step / choice.spin_time_step_limit
+        verdict = ("resolved" if ratio <= 1.0 else
+                   f"the step is {ratio:.2f}× it: the particles' spin in the bed is numerical "
+                   "(README, 'The spin limit')")
+        table.add_row("spin limit", f"{choice.spin_time_step_limit:.3g} s for the bed's contacts; {verdict}")
     console.print(table)
 
 

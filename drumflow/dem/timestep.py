@@ -57,6 +57,117 @@ def typical_impact_velocity(case: Case) -> float:
     return 0.5 * impact_velocity(case)
 
 
+#: Contacts per particle in the packed bed for :func:`spin_time_step_limit`: a dense random
+#: packing of frictional spheres has 4.5-6; the upper end, so the limit is not optimistic.
+BED_CONTACTS = 6
+#: Solid fraction of the packed bed for :func:`bed_contact_overlap` (random packing, 0.55-0.64).
+BED_SOLID_FRACTION = 0.6
+
+
+def verlet_damping_limit(damping_ratio: float) -> float:
+    """Largest ``omega dt`` at which a damped linear oscillator stays stable under LIGGGHTS'
+    velocity Verlet, whose dashpots use the half-step velocity: ``2 (sqrt(1 + zeta^2) - zeta)``.
+
+    2 without damping; about ``1 / zeta`` for a heavily damped mode, i.e. the explicit dashpot's
+    own limit ``dt < 2 m / c``. (The amplification matrix of the scheme applied to
+    ``x'' + 2 zeta omega x' + omega^2 x = 0`` has spectral radius 1 there; the unit tests check
+    it against the eigenvalues.)
+    """
+    if damping_ratio < 0.0:
+        raise ValueError(f"damping_ratio = {damping_ratio!r}: must be >= 0")
+    return 2.0 * (math.sqrt(1.0 + damping_ratio**2) - damping_ratio)
+
+
+@dataclass(frozen=True)
+class SpinMode:
+    """The fastest rotational mode of a particle in enduring contacts (:func:`spin_mode`)."""
+
+    frequency: float  # rad/s
+    damping_ratio: float
+    time_step_limit: float  # s: above it, velocity Verlet excites the mode instead of damping it
+
+    def as_dict(self) -> dict[str, Any]:
+        return asdict(self)
+
+
+def spin_mode(radius: float, density: float, youngs_modulus: float, poisson: float,
+              restitution: float, overlap: float, contacts: int = BED_CONTACTS) -> SpinMode:
+    """The spin of a particle against ``contacts`` equal neighbours spinning the other way, the
+    fastest rotational mode of a packed bed, with LIGGGHTS' Hertz tangential spring and dashpot.
+
+    At each contact the surfaces slide at ``2 a w`` (w the spin rate, ``a = r - delta / 2`` the
+    lever arm to the contact point, as LIGGGHTS takes it), against the tangential spring
+    ``k_t = 8 G* sqrt(R* delta)`` and dashpot ``g_t = 2 sqrt(5/6) |beta| sqrt(k_t m*)``
+    (``beta = ln e / sqrt(ln^2 e + pi^2)``, ``m* = m / 2``), so with ``I = 2/5 m r^2``:
+    ``omega^2 = 2 n k_t a^2 / I`` and ``2 zeta omega = 2 n g_t a^2 / I``. The dashpot is
+    designed for the translational mass ``m*``, but spin moves only ``I / a^2`` (about 0.4 m):
+    the rotational mode is damped beyond critical, and its explicit dashpot limits the step
+    (:func:`verlet_damping_limit`). Above that step the dashpot excites the spin at every step
+    until the contact slides (Coulomb): a numerical spin the bed keeps. For ``contacts = 1``
+    this is two particles spinning the same way on one contact, which LIGGGHTS reproduces
+    (tests/solver/test_spin_liggghts.py).
+
+    Parameters
+    ----------
+    radius, density, youngs_modulus, poisson
+        The particles (m, kg/m3, Pa, -).
+    restitution
+        The restitution coefficient LIGGGHTS is given (after the step's calibration).
+    overlap
+        Normal overlap of the contacts, m (:func:`bed_contact_overlap`).
+    contacts
+        Contacts per particle.
+    """
+    if not 0.0 < restitution < 1.0:
+        raise ValueError(f"restitution = {restitution!r}: must be in (0, 1)")
+    if not 0.0 < overlap < radius:
+        raise ValueError(f"overlap = {overlap!r}: must be in (0, radius)")
+    mass = density * 4.0 / 3.0 * math.pi * radius**3
+    inertia = 0.4 * mass * radius**2
+    arm = radius - 0.5 * overlap
+    shear = youngs_modulus / (2.0 * (1.0 + poisson))
+    g_eff = shear / (2.0 * (2.0 - poisson))
+    k_t = 8.0 * g_eff * math.sqrt(0.5 * radius * overlap)
+    log_e = math.log(restitution)
+    beta = abs(log_e) / math.sqrt(log_e**2 + math.pi**2)
+    g_t = 2.0 * math.sqrt(5.0 / 6.0) * beta * math.sqrt(k_t * 0.5 * mass)
+    omega = math.sqrt(2.0 * contacts * k_t * arm**2 / inertia)
+    zeta = 2.0 * contacts * g_t * arm**2 / inertia / (2.0 * omega)
+    return SpinMode(omega, zeta, verlet_damping_limit(zeta) / omega)
+
+
+def bed_contact_overlap(case: Case) -> float:
+    """The Hertz overlap of a contact at the bottom of the bed at rest, m: the weight of the
+    column above one particle (depth of the circular segment the particles fill at
+    :data:`BED_SOLID_FRACTION`, times ``d^2``) on one contact."""
+    from scipy.optimize import brentq
+
+    p = case.particles
+    r_drum = case.drum.radius
+    bulk = case.particle_mass_total / p.density / BED_SOLID_FRACTION
+    area = min(bulk / case.drum.length, 0.999 * math.pi * r_drum**2)
+
+    def segment(h: float) -> float:
+        return r_drum**2 * math.acos((r_drum - h) / r_drum) - (r_drum - h) * math.sqrt(2 * r_drum * h - h * h)
+
+    depth = brentq(lambda h: segment(h) - area, 0.0, 2.0 * r_drum)
+    force = p.density * BED_SOLID_FRACTION * G * depth * p.diameter**2
+    e_eff = p.youngs_modulus / (2.0 * (1.0 - p.poisson_ratio**2))
+    return float((3.0 * force / (4.0 * e_eff * math.sqrt(0.5 * p.radius))) ** (2.0 / 3.0))
+
+
+def bed_spin_mode(case: Case, time_step: float) -> SpinMode:
+    """:func:`spin_mode` of the case's particle-particle contacts at the bottom of its bed
+    (:func:`bed_contact_overlap`), with the restitution coefficient a run at ``time_step``
+    gives LIGGGHTS (:func:`drumflow.dem.restitution.calibrate_case`)."""
+    from drumflow.dem.restitution import calibrate_case  # it imports this module
+
+    p = case.particles
+    coefficient = calibrate_case(case, time_step)["particle_particle"].liggghts_value
+    return spin_mode(p.radius, p.density, p.youngs_modulus, p.poisson_ratio, coefficient,
+                     min(bed_contact_overlap(case), 0.5 * p.radius))
+
+
 @dataclass(frozen=True)
 class TimeStepChoice:
     """The DEM time step and where it came from (recorded in the manifest)."""
@@ -67,6 +178,9 @@ class TimeStepChoice:
     fraction_of_rayleigh: float
     steps_per_contact: float
     mode: str  # "auto", "fixed", or "forced" (fixed above the stability limit, on request)
+    #: The step above which the tangential dashpot excites the spin of the bed's enduring
+    #: contacts (:func:`bed_spin_mode`): reported, not enforced (the defaults exceed it).
+    spin_time_step_limit: float | None = None
 
     def as_dict(self) -> dict[str, Any]:
         return asdict(self)
@@ -117,4 +231,5 @@ def choose_time_step(case: Case) -> TimeStepChoice:
         fraction_of_rayleigh=dt / t_r,
         steps_per_contact=t_h / dt,
         mode=mode,
+        spin_time_step_limit=bed_spin_mode(case, dt).time_step_limit,
     )

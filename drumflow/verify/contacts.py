@@ -159,17 +159,18 @@ def decay_conductance(dT0: float, dTN: float, steps: int, dt: float, mcp_i: floa
 # ---------------------------------------------------------------------------------------------
 
 
-def _run_pair(work: Path, runner: Runner, context: dict[str, object], timeout: float = 300.0) -> pd.DataFrame:
+def _run_pair(work: Path, runner: Runner, context: dict[str, object], timeout: float = 300.0,
+              columns: tuple[str, ...] = _COLUMNS) -> pd.DataFrame:
     """Render ``two_particles.in.j2``, run LIGGGHTS on one process, return the thermo table."""
     work.mkdir(parents=True, exist_ok=True)
     deck = render_deck(context, "two_particles.in.j2")
     (work / "in.pair").write_text(deck)
     command = runner.profile.mpi_command(["liggghts", "-in", "in.pair", "-log", "log.liggghts"], 1)
     runner.run("liggghts", command, work, work / "liggghts.out", timeout=timeout)
-    parser = ThermoParser(columns=_COLUMNS)
+    parser = ThermoParser(columns=columns)
     for line in (work / "log.liggghts").read_text(errors="replace").splitlines():
         parser(line)
-    table = pd.DataFrame(parser.rows, columns=list(_COLUMNS))
+    table = pd.DataFrame(parser.rows, columns=list(columns))
     return table.drop_duplicates("step", keep="last").reset_index(drop=True)
 
 
@@ -302,6 +303,53 @@ def restitution_check(
                  "realised_per_phase": realised,
                  "replay_max_abs_difference": replay_gap},
     )
+
+
+@dataclass(frozen=True)
+class SpinResult:
+    """Two held particles spinning on one contact (:func:`run_spin`)."""
+
+    time_step: float
+    predicted_limit: float  # s, drumflow.dem.timestep.spin_mode for one contact
+    energy_ratio: float  # rotational energy at the end over the start
+
+    @property
+    def damped(self) -> bool:
+        return self.energy_ratio < 1.0
+
+
+def run_spin(work: Path, runner: Runner, time_step_factor: float, overlap_fraction: float = 0.19,
+             restitution: float = 0.1205, youngs_modulus: float = PAPER_YOUNGS_MODULUS,
+             spin: float = 1.0, steps: int = 400) -> SpinResult:
+    """Two equal spheres held with overlap ``overlap_fraction`` * r, both spinning at ``spin``
+    rad/s the same way (their surfaces slide at the contact, against its tangential spring
+    and dashpot), at ``time_step_factor`` times the step limit :func:`spin_mode` predicts.
+
+    Below the limit the dashpot damps the spin away; above it the spin grows until the contact
+    slides. Rolling friction is off (its constant torque would mask the spring). The defaults
+    are paper model one's particles at its bed overlap and its default step's coefficient.
+    """
+    from drumflow.dem.timestep import spin_mode
+
+    radius = 0.5 * DIAMETER
+    overlap = overlap_fraction * radius
+    limit = spin_mode(radius, DENSITY, youngs_modulus, POISSON, restitution, overlap,
+                      contacts=1).time_step_limit
+    dt = time_step_factor * limit
+    half = 0.5 * (DIAMETER - overlap)
+    box = 0.05
+    work.mkdir(parents=True, exist_ok=True)
+    (work / "spin.data").write_text(
+        "two spheres spinning the same way\n\n2 atoms\n1 atom types\n\n"
+        + "".join(f"{-box} {box} {a}lo {a}hi\n" for a in "xyz")
+        + f"\nAtoms\n\n1 1 {DIAMETER} {DENSITY} {-half:.12g} 0 0\n2 1 {DIAMETER} {DENSITY} {half:.12g} 0 0\n"
+        + f"\nVelocities\n\n1 0 0 0 0 0 {spin:.12g}\n2 0 0 0 0 0 {spin:.12g}\n")
+    ctx = _base_context(youngs_modulus, dt)
+    ctx.update(mode="spin", restitution=f"{restitution:.9g}", rolling_friction=0.0, steps=steps,
+               thermo_every=steps)
+    table = _run_pair(work, runner, ctx, columns=("step", "time", "rke"))
+    first, last = float(table["rke"].iloc[0]), float(table["rke"].iloc[-1])
+    return SpinResult(dt, limit, last / first)
 
 
 @dataclass(frozen=True)

@@ -96,3 +96,18 @@ def test_a_bed_restitution_variant_is_exact_at_the_bed_speed() -> None:
             apply_variant(deck, variant, 2, case)
         e_pp, _ = _coefficients(apply_variant(deck, variant, 2, case, bed_speed=0.14))
         assert mean_realised_restitution(e_pp, dt, m, r, e, 0.14) == pytest.approx(0.1, rel=1e-4)
+
+
+def test_the_tangential_damping_diagnostic_edits_the_pair_style_only() -> None:
+    case = load_case(ROOT / "cases" / "paper_model_one.toml")
+    walls = ("fix walls all wall/gran model hertz tangential history rolling_friction cdt mesh "
+             "n_meshes 1 meshes shell\n")
+    deck = (_deck(1.2e-4, 0.1205, 0.313)
+            + "pair_style      gran model hertz tangential history rolling_friction cdt\n" + walls)
+    variant = next(v for v in VARIANTS if v.name == "no_tangential_damping")
+    edited = apply_variant(deck, variant, 2, case)
+    assert ("pair_style      gran model hertz tangential history rolling_friction cdt "
+            "tangential_damping off\n") in edited
+    assert walls in edited and _coefficients(edited) == (0.1205, 0.313)
+    with pytest.raises(SettingsStudyError, match="pair_style"):
+        apply_variant(_deck(1.2e-4, 0.1205, 0.313), variant, 2, case)

@@ -1,0 +1,88 @@
+"""The spin limit of the DEM step (drumflow.dem.timestep): the stability of velocity Verlet with
+a half-step dashpot, and the rotational mode of a bed contact. LIGGGHTS itself:
+tests/solver/test_spin_liggghts.py."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from drumflow.case import load_case
+from drumflow.dem.timestep import bed_contact_overlap, spin_mode, verlet_damping_limit
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def _spectral_radius(omega_dt: float, zeta: float) -> float:
+    """Velocity Verlet on x'' = -w^2 x - 2 zeta w v, the damping taken at the half-step
+    velocity (as LAMMPS computes forces between the two half kicks); state (x, v, a), dt = 1."""
+
+    def step(state: np.ndarray) -> np.ndarray:
+        x, v, a = state
+        v_half = v + 0.5 * a
+        x_new = x + v_half
+        a_new = -omega_dt**2 * x_new - 2.0 * zeta * omega_dt * v_half
+        return np.array([x_new, v_half + 0.5 * a_new, a_new])
+
+    matrix = np.column_stack([step(e) for e in np.eye(3)])
+    return float(np.abs(np.linalg.eigvals(matrix)).max())
+
+
+@pytest.mark.parametrize("zeta", [0.0, 0.3, 0.8, 1.8, 4.0])
+def test_the_limit_is_where_the_scheme_stops_damping(zeta: float) -> None:
+    limit = verlet_damping_limit(zeta)
+    assert _spectral_radius(0.99 * limit, zeta) <= 1.0 + 1e-9
+    assert _spectral_radius(1.01 * limit, zeta) > 1.0 + 1e-6
+
+
+def test_the_undamped_and_overdamped_ends() -> None:
+    assert verlet_damping_limit(0.0) == pytest.approx(2.0)
+    # Heavily damped: the explicit dashpot's own limit, 1 / zeta (dt < 2 m / c).
+    assert verlet_damping_limit(50.0) == pytest.approx(1.0 / 50.0, rel=1e-3)
+    with pytest.raises(ValueError, match="damping_ratio"):
+        verlet_damping_limit(-0.1)
+
+
+def test_one_contact_mode_by_hand() -> None:
+    """Two 8 mm, 517 kPa spheres at 0.19 r, e = 0.1205: k_t = 8 G* sqrt(R* delta) = 567 N/m,
+    the dashpot 0.29 N s/m, lever arm r - delta/2: the numbers the solver test bisected
+    (LIGGGHTS' limit between 3.5 and 3.6e-4 s)."""
+    r, delta = 0.004, 0.19 * 0.004
+    mode = spin_mode(r, 1050.0, 517e3, 0.45, 0.1205, delta, contacts=1)
+    mass = 1050.0 * 4.0 / 3.0 * math.pi * r**3
+    g_eff = 517e3 / (2 * 1.45) / (2 * 1.55)
+    k_t = 8 * g_eff * math.sqrt(0.5 * r * delta)
+    assert k_t == pytest.approx(567.2, rel=1e-3)
+    arm = r - 0.5 * delta
+    assert mode.frequency == pytest.approx(math.sqrt(2 * k_t * arm**2 / (0.4 * mass * r**2)))
+    assert 3.5e-4 < mode.time_step_limit < 3.6e-4
+    # More contacts: a stiffer, more damped mode and a shorter limit.
+    bed = spin_mode(r, 1050.0, 517e3, 0.45, 0.1205, delta)
+    assert bed.frequency == pytest.approx(math.sqrt(6) * mode.frequency)
+    assert bed.time_step_limit < 0.25 * mode.time_step_limit
+    with pytest.raises(ValueError, match="overlap"):
+        spin_mode(r, 1050.0, 517e3, 0.45, 0.1205, 0.0)
+    with pytest.raises(ValueError, match="restitution"):
+        spin_mode(r, 1050.0, 517e3, 0.45, 1.0, delta)
+
+
+def test_the_paper_beds_overlap_and_their_default_step() -> None:
+    """The bed's weight gives model one's contacts about a fifth of a radius (the stability
+    monitor's reading in the full run); the default step (10 per Hertz contact at the
+    free-fall speed) is then 1.6 times the bed's spin limit, and half of it is below."""
+    from drumflow.dem.restitution import calibrate_case
+    from drumflow.dem.stage import plan_run
+
+    case = load_case(ROOT / "cases" / "paper_model_one.toml")
+    p = case.particles
+    overlap = bed_contact_overlap(case)
+    assert 0.15 < overlap / p.radius < 0.25
+    _, plan = plan_run(case)
+    for factor, low, high in ((1.0, 1.5, 1.7), (0.5, 0.75, 0.9)):
+        dt = factor * plan.time_step
+        e = calibrate_case(case, dt)["particle_particle"].liggghts_value
+        limit = spin_mode(p.radius, p.density, p.youngs_modulus, p.poisson_ratio, e, overlap).time_step_limit
+        assert low < dt / limit < high
