@@ -57,7 +57,7 @@ def typical_impact_velocity(case: Case) -> float:
     return 0.5 * impact_velocity(case)
 
 
-#: Contacts per particle in the packed bed for :func:`spin_time_step_limit`: a dense random
+#: Contacts per particle in the packed bed for :func:`spin_mode`: a dense random
 #: packing of frictional spheres has 4.5-6; the upper end, so the limit is not optimistic.
 BED_CONTACTS = 6
 #: Solid fraction of the packed bed for :func:`bed_contact_overlap` (random packing, 0.55-0.64).
@@ -140,7 +140,7 @@ def bed_contact_overlap(case: Case) -> float:
     """The Hertz overlap of a contact at the bottom of the bed at rest, m: the weight of the
     column above one particle (depth of the circular segment the particles fill at
     :data:`BED_SOLID_FRACTION`, times ``d^2``) on one contact."""
-    from scipy.optimize import brentq
+    from scipy.optimize import brentq  # here: importing this module stays light (CLI start-up)
 
     p = case.particles
     r_drum = case.drum.radius
