@@ -197,7 +197,11 @@ class Run(_Section):
     """How long and how finely to simulate."""
 
     time: float = Field(gt=0, le=3600, description="simulated time, s")
-    time_step: Positive | Literal["auto"] = Field("auto", description="DEM time step, s, or 'auto'")
+    time_step: Positive | Literal["auto", "contact"] = Field(
+        "auto", description="DEM time step, s, or 'auto': the largest that resolves the fastest "
+        "contact in 10 steps, stays below run.rayleigh_fraction of the Rayleigh time and below 0.8 "
+        "of the bed's spin limit; 'contact': the same without the spin limit (faster for beds of "
+        "soft, deeply overlapping particles; their spin is then numerical, README 'The spin limit')")
     rayleigh_fraction: float = Field(
         0.2, gt=0, le=0.5, description="'auto' time step as a fraction of the Rayleigh time"
     )

@@ -68,13 +68,15 @@ def check(case_file: Annotated[Path, typer.Argument(help="case file (TOML)")]) -
     if moved is not case:
         table.add_row("DEM parcels", f"{moved.particle_count:,} × {moved.particles.diameter * 1e3:g} mm "
                       f"(coarse_grain {case.particles.coarse_grain:g}; drag and heat per kg kept)")
-    table.add_row("time step", f"{choice.time_step:.3g} s ({choice.mode}; {choice.fraction_of_rayleigh:.0%} "
-                  f"of Rayleigh {choice.rayleigh_time:.3g} s; "
+    bound = {"rayleigh": "set by run.rayleigh_fraction", "contact": "set by the fastest contact",
+             "spin": "set by the bed's spin limit", "user": "run.time_step"}.get(choice.bound or "", "")
+    table.add_row("time step", f"{choice.time_step:.3g} s ({choice.mode}, {bound}; "
+                  f"{choice.fraction_of_rayleigh:.0%} of Rayleigh {choice.rayleigh_time:.3g} s; "
                   f"{choice.steps_per_contact:.0f} steps per contact)")
     table.add_row("steps", f"{round(case.run.time / choice.time_step):,} for {case.run.time:g} s")
     if choice.spin_time_step_limit is not None:
         ratio = choice.time_step / choice.spin_time_step_limit
-        verdict = ("resolved" if ratio <= 1.0 else
+        verdict = (f"resolved (the step is {ratio:.2f}× it)" if ratio <= 1.0 else
                    f"the step is {ratio:.2f}× it: the particles' spin in the bed is numerical "
                    "(README, 'The spin limit')")
         table.add_row("spin limit", f"{choice.spin_time_step_limit:.3g} s for the bed's contacts; {verdict}")

@@ -7,6 +7,7 @@
 from __future__ import annotations
 
 import json
+import math
 import os
 import socket
 import time
@@ -37,9 +38,11 @@ from drumflow.dem.stage import (
     DemResult,
     ProgressCallback,
     clear_stop_request,
+    kept_time_step,
     plan_run,
 )
 from drumflow.dem.thermo import read_thermo
+from drumflow.dem.timestep import choose_time_step
 from drumflow.errors import CaseError, RunDirectoryError
 from drumflow.report.plots import (
     plot_air_heat,
@@ -118,8 +121,16 @@ def run_case(
     if progress:
         progress("geometry", 1.0, 1.0)
     # The one choice of the time step and the processes: the air coupling and the DEM stage
-    # both use them.
-    choice, plan = plan_run(moved, steps)
+    # both use them. A run being resumed keeps the step it started with.
+    kept = kept_time_step(moved, rundir, steps)
+    choice, plan = plan_run(moved, steps, kept)
+    if kept is not None:
+        now = choose_time_step(moved)
+        if not math.isclose(now.time_step, kept.time_step, rel_tol=1e-12):
+            rundir.record("time_step_kept", {
+                "time_step": kept.time_step, "drumflow_now_chooses": now.as_dict(),
+                "why": "a run keeps the step it started with; start it afresh in another "
+                       "directory for the new step"})
     nprocs = runner.profile.processes_for(moved)
     coupling = _air(case, rundir, runner, nprocs, plan.time_step, plan.dump_every, progress)
     rundir.record("skips", skips(moved, choice.mode, coupling is not None, shape.wall_motion, nprocs))

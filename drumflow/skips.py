@@ -75,8 +75,14 @@ def skips(case: Case, time_step_mode: str, coupled: bool, wall_motion: str,
 
     add("static shell with a surface velocity instead of a rotating shell mesh (only the "
         "lifters move)", wall_motion == "static_shell", "default", "moving_mesh")
-    add("time step 'auto' (min of 20% of the Rayleigh time and 1/10 of the Hertz contact) "
-        "instead of 10% of the Rayleigh time", time_step_mode == "auto", "default", "dt_10pct")
+    # The shipped smoke bench's "default" rung ran the contact rule (the 'auto' before the spin
+    # limit): its numbers belong to 'contact'. The spin-limited 'auto' is within 8 % of 10 % of
+    # the smoke case's Rayleigh time and has no rung of its own yet: recorded unmeasured.
+    add("time step 'contact' (min of 20% of the Rayleigh time and 1/10 of the Hertz contact) "
+        "instead of 10% of the Rayleigh time", time_step_mode == "contact", "default", "dt_10pct")
+    add("time step 'auto' (min of 20% of the Rayleigh time, 1/10 of the Hertz contact and 0.8 "
+        "of the bed's spin limit) instead of 10% of the Rayleigh time", time_step_mode == "auto",
+        "auto_below_spin_limit", "dt_10pct")
     add("air updated every 'auto' steps (0.2% of the particles' thermal time constant) instead "
         "of every 10 steps", coupled and case.air.coupling_interval == "auto", "default", "coupling_10")
     add("serial run (few particles per process) instead of 2 MPI processes",

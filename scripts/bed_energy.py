@@ -40,6 +40,8 @@ from drumflow.dem.timestep import bed_spin_mode  # noqa: E402
 
 def energy_table(run: Path, every: float) -> pd.DataFrame:
     """One thermo row per ``every`` s (the first in each bin) with the spin rate."""
+    if not every > 0:  # also refuses NaN
+        raise ValueError(f"--every = {every:g} s: must be positive")
     case = load_case(run / "case.toml").dem_case()
     thermo = read_thermo(run / "dem")
     if thermo.empty:

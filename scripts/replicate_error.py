@@ -8,7 +8,9 @@ How to use::
 FIRST and SECOND are run directories (or shipped results folders, see
 ``scripts/ship_paper_run.py``) of the same case (same physics; the launch, the processor grid
 and the attempt history may differ, so their round-off does and the trajectories part
-chaotically). Compared over the output times both reached, up to ``--until``:
+chaotically), or of two cases that differ only in the fields named by ``--differ FIELD``
+(``--differ name --differ run.time_step``: one setting against another). Compared over the
+output times both reached, up to ``--until``:
 
 * the mean temperature (post/mean_temperature.csv): the largest difference over all common
   times, the difference at the last one, and the cooling from the start to it;
@@ -58,6 +60,8 @@ def _time_step(root: Path) -> float:
 
 def _window_edges(end: float, window: float) -> np.ndarray:
     """0, window, 2 window, ... and ``end`` itself when it falls between two of them."""
+    if not window > 0:  # also refuses NaN
+        raise ValueError(f"--window = {window:g} s: must be positive")
     edges = np.arange(0.0, end + 1e-9, window)
     return np.append(edges, end) if edges[-1] < end - 1e-9 else edges
 
@@ -82,11 +86,28 @@ def _wall_per_window(root: Path, time_step: float, edges: np.ndarray) -> np.ndar
     return out
 
 
-def compare(first: Path, second: Path, until: float, window: float) -> tuple[pd.DataFrame, dict[str, Any]]:
-    """The per-window table and the summary (see the module docstring)."""
+def _case_differences(a: dict[str, Any], b: dict[str, Any], prefix: str = "") -> list[str]:
+    """Dotted names of the fields where two case dumps differ."""
+    out = []
+    for key in sorted(set(a) | set(b)):
+        x, y = a.get(key), b.get(key)
+        if isinstance(x, dict) and isinstance(y, dict):
+            out += _case_differences(x, y, f"{prefix}{key}.")
+        elif x != y:
+            out.append(f"{prefix}{key}")
+    return out
+
+
+def compare(first: Path, second: Path, until: float, window: float,
+            differ: tuple[str, ...] = ()) -> tuple[pd.DataFrame, dict[str, Any]]:
+    """The per-window table and the summary (see the module docstring). ``differ`` names the
+    case fields the two runs may differ in (``run.time_step``: a comparison of two settings)."""
     case_a, case_b = load_case(first / "case.toml"), load_case(second / "case.toml")
-    if case_a.model_dump() != case_b.model_dump():
-        raise ValueError(f"{first} and {second} are not runs of the same case")
+    differences = _case_differences(case_a.model_dump(), case_b.model_dump())
+    unexpected = [name for name in differences if name not in differ]
+    if unexpected:
+        raise ValueError(f"{first} and {second} are not runs of the same case: they differ in "
+                         f"{', '.join(unexpected)} (--differ FIELD allows a field)")
     moved = case_a.dem_case()
     mass = moved.particles.mass
     a, b = _series(first), _series(second)
@@ -121,7 +142,7 @@ def compare(first: Path, second: Path, until: float, window: float) -> tuple[pd.
             "wall_s_per_simulated_s_second": wall_b[i],
         })
     summary = {
-        "first": str(first), "second": str(second), "case": case_a.name,
+        "first": str(first), "second": str(second), "case": case_a.name, "differ_in": differences,
         "common_output_times": len(merged), "last_common_time_s": end, "window_s": window,
         "max_abs_temperature_difference_K": float(np.abs(diff).max()),
         "temperature_difference_at_end_K": float(diff.iloc[-1]),
@@ -161,11 +182,13 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("out", type=Path)
     parser.add_argument("--until", type=float, default=math.inf, help="compare up to this time, s")
     parser.add_argument("--window", type=float, default=0.5, help="window length, s")
+    parser.add_argument("--differ", action="append", default=[], metavar="FIELD",
+                        help="a case field the two runs may differ in (e.g. run.time_step); repeat")
     parser.add_argument("--progress", action="store_true",
                         help="also write progress.csv: the second run alone over all it reached")
     args = parser.parse_args(argv)
     try:
-        table, summary = compare(args.first, args.second, args.until, args.window)
+        table, summary = compare(args.first, args.second, args.until, args.window, tuple(args.differ))
         ahead = progress(args.second, args.window) if args.progress else None
     except (DrumflowError, OSError, KeyError, ValueError) as exc:
         sys.stderr.write(f"error: {exc}\n")

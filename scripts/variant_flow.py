@@ -41,6 +41,8 @@ def _interval(study: Path) -> tuple[float, float, Path]:
 
 
 def flows(study: Path, run: Path | None, window: float) -> tuple[pd.DataFrame, dict[str, Any]]:
+    if not window > 0:  # also refuses NaN
+        raise ValueError(f"--window = {window:g} s: must be positive")
     start, end, source = _interval(study)
     mass = load_case(source / "case.toml").dem_case().particles.mass
     crossings: dict[str, pd.Series] = {}

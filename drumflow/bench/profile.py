@@ -230,14 +230,19 @@ def _attempts(rundir: RunDir) -> list[tuple[int, Path]]:
     return sorted(found)
 
 
-def _time_step(rundir: RunDir) -> float | None:
+def _clock(rundir: RunDir) -> tuple[float | None, tuple[int, float]]:
+    """The DEM step and the (step, time) the run's clock counts from: (0, 0) but for a
+    settings-study variant with another step, whose coupling input names its restart's."""
+    spec_path = rundir.dem / "coupling.json"
+    spec = json.loads(spec_path.read_text()) if spec_path.is_file() else {}
+    step, time = spec.get("clock_origin", [0, 0.0])
+    origin = (int(step), float(time))
     value = (rundir.manifest.get("time_step") or {}).get("time_step")
     if value:
-        return float(value)
-    spec = rundir.dem / "coupling.json"
-    if spec.is_file():
-        return float(json.loads(spec.read_text())["time_step"])
-    return None
+        return float(value), origin
+    if "time_step" in spec:
+        return float(spec["time_step"]), origin
+    return None, origin
 
 
 def _runs(rundir: RunDir) -> pd.DataFrame:
@@ -359,14 +364,14 @@ def profile_run(run_dir: Path, window_s: float = WINDOW_S) -> RunProfile:
     if runs.empty:
         raise RunDirectoryError(f"{rundir.root}: no LIGGGHTS log with a run in {rundir.dem}; "
                                 "run `drumflow run` first")
-    dt = _time_step(rundir)
+    dt, (origin_step, origin_time) = _clock(rundir)
     if dt is None:
         # The deck's thermo prints step and step*dt side by side.
         valid = runs[runs["step"] > 0]
         dt = float((valid["sim_time_s"] / valid["step"]).median())
-    runs["end_time_s"] = runs["step"] * dt
-    runs["start_time_s"] = (runs["step"] - runs["steps"]) * dt
-    coupling = read_coupling(rundir.dem_coupling_logs, dt)
+    runs["end_time_s"] = origin_time + (runs["step"] - origin_step) * dt
+    runs["start_time_s"] = runs["end_time_s"] - runs["steps"] * dt
+    coupling = read_coupling(rundir.dem_coupling_logs, dt, (origin_step, origin_time))
     sampled = runs[runs["breakdown"]].copy()
     if sampled.empty:
         raise RunDirectoryError(

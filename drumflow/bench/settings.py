@@ -368,6 +368,14 @@ def baseline_deck(rundir: RunDir, restart_step: int, ranks: int, scratch: Path,
     return (source.dem / deck_name).read_text(), "rendered from the case (drumflow.dem.stage.write_deck)"
 
 
+def variant_clock(deck: str, start_step: int, start_time: float) -> str:
+    """The deck with its thermo clock counting from the restart's (step, time): after a change
+    of step the deck's ``step*dt`` would put the restart at another time (a regression: the
+    half-step variants' thermo times were half the run's)."""
+    return _replace_line(deck, r"^variable\s+sim_time\s+equal\s+.*$",
+                         f"variable sim_time equal {start_time:.12g}+(step-{start_step})*dt")
+
+
 def _prepare(folder: Path, rundir: RunDir, restart: Path, deck: str, driver: dict[str, Any],
              end_step: int, time_step_factor: float = 1.0, start_step: int = 0,
              loop_heat: bool = False, overlap_every_row: bool = False) -> None:
@@ -382,7 +390,6 @@ def _prepare(folder: Path, rundir: RunDir, restart: Path, deck: str, driver: dic
     shutil.copytree(rundir.geometry, folder / "geometry")
     # Linked under input/, never under restart/: LIGGGHTS writes its own restarts there.
     (dem / RESTART_INPUT / restart.name).symlink_to(restart.resolve())
-    (dem / "in.drum.resume").write_text(deck)
     spec = {k: v for k, v in driver.items() if k != "stop"}  # exactly --steps steps
     spec.update(deck="in.drum.resume", log="log.liggghts", total_steps=end_step, tail=[],
                 profile_every_steps=1)  # a breakdown after every coupling interval
@@ -391,6 +398,8 @@ def _prepare(folder: Path, rundir: RunDir, restart: Path, deck: str, driver: dic
         spec.update(time_step=dt * time_step_factor,
                     interval=max(1, round(int(driver["interval"]) / time_step_factor)),
                     clock_origin=[start_step, start_step * dt])
+        deck = variant_clock(deck, start_step, start_step * dt)
+    (dem / "in.drum.resume").write_text(deck)
     if overlap_every_row:
         # The loop leaves the deck's overlap formula alone: every row (or none) evaluates it.
         spec.pop("overlap_every", None)

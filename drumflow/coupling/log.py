@@ -22,8 +22,13 @@ WALL_COLUMNS = ("python_wall_s", "liggghts_wall_s")
 PAUSED_FACTOR = 20.0
 
 
-def read_coupling(folder: Path, time_step: float) -> pd.DataFrame:
+def read_coupling(folder: Path, time_step: float,
+                  origin: tuple[int, float] = (0, 0.0)) -> pd.DataFrame:
     """One row per coupling update: step, time, steps held, heat (W) and drag (N) on all particles.
+
+    ``origin`` is the (step, time) the clock counts from: a run that changed its step at a
+    restart (a settings study's time-step variant, ``clock_origin`` in its coupling input) is
+    not at ``step * time_step``.
 
     Each rank logs its own particles (``rank<R>.<start step>.csv``); a resumed attempt supersedes
     what earlier attempts logged from its start step on.
@@ -64,7 +69,7 @@ def read_coupling(folder: Path, time_step: float) -> pd.DataFrame:
         end = starts[i + 1] if i + 1 < len(starts) else np.inf
         kept.append(summed[summed["step"] < end])
     table = pd.concat(kept, ignore_index=True).sort_values("step").reset_index(drop=True)
-    table.insert(1, "time_s", table["step"] * time_step)
+    table.insert(1, "time_s", origin[1] + (table["step"] - origin[0]) * time_step)
     # The heat is held constant over `steps` DEM steps: LIGGGHTS adds it at each of them.
     table["heat_removed_J"] = np.cumsum(-table["heat_to_particles_W"] * table["steps"] * time_step)
     present = [name for name in WALL_COLUMNS if name in table.columns]

@@ -12,7 +12,8 @@ from drumflow._lazy import lazy_exports
 
 _EXPORTS = {
     **{name: "drumflow.dem.stage" for name in
-       ("DemInputs", "DemResult", "ProgressCallback", "dem_key", "plan_run", "run")},
+       ("DemInputs", "DemResult", "ProgressCallback", "dem_key", "kept_time_step", "plan_run",
+        "run")},
     "ThermoParser": "drumflow.dem.thermo",
 }
 __all__ = [
@@ -21,6 +22,7 @@ __all__ = [
     "ProgressCallback",
     "ThermoParser",
     "dem_key",
+    "kept_time_step",
     "plan_run",
     "run",
 ]
@@ -32,6 +34,7 @@ if TYPE_CHECKING:
         DemResult,
         ProgressCallback,
         dem_key,
+        kept_time_step,
         plan_run,
         run,
     )

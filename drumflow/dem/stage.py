@@ -67,8 +67,8 @@ if TYPE_CHECKING:
     from drumflow.rundir import RunDir
     from drumflow.runner import Runner
 
-__all__ = ["DemInputs", "DemResult", "ProgressCallback", "clear_stop_request", "dem_key", "plan_run",
-           "request_stop", "run"]
+__all__ = ["DemInputs", "DemResult", "ProgressCallback", "clear_stop_request", "dem_key", "kept_time_step",
+           "plan_run", "request_stop", "run"]
 
 #: progress(stage, done, total): simulated seconds done out of the total.
 ProgressCallback = Callable[[str, float, float], None]
@@ -159,12 +159,37 @@ def _stop_record(rundir: RunDir) -> dict[str, Any] | None:
     return json.loads(path.read_text()) if path.exists() else None
 
 
-def plan_run(case: Case, steps: int | None = None) -> tuple[TimeStepChoice, StepPlan]:
-    """The one choice of the DEM time step for a run, and the step plan that follows from it
-    (cut to ``steps`` for a short start-up run)."""
-    choice = choose_time_step(case)
+def plan_run(case: Case, steps: int | None = None,
+             choice: TimeStepChoice | None = None) -> tuple[TimeStepChoice, StepPlan]:
+    """The one choice of the DEM time step for a run (``choice``, e.g. :func:`kept_time_step`,
+    or :func:`choose_time_step`'s), and the step plan that follows from it (cut to ``steps``
+    for a short start-up run)."""
+    if choice is None:
+        choice = choose_time_step(case)
     plan = plan_steps(case, choice)
     return choice, plan if steps is None else short_plan(plan, steps)
+
+
+def kept_time_step(case: Case, rundir: RunDir, steps: int | None = None) -> TimeStepChoice | None:
+    """The time step a run of ``case`` in ``rundir`` started with, when ``drumflow run`` will
+    resume it (a restart to resume from) or reuse it (its DEM stage finished); else None.
+
+    A run keeps its step for life, even when a later drumflow chooses another for the same case
+    (as "auto" did when it came to respect the spin limit): a change of step at a restart would
+    put LIGGGHTS' step counter at another time, and would change the air-update interval and
+    with it the stage's key, so the run would start afresh and delete its restarts.
+    """
+    record = rundir.manifest.get("time_step")
+    key = str(rundir.manifest.get("dem_key", ""))
+    if steps is not None or not record or ":steps=" in key or key.split(":")[0] != case.hash():
+        return None
+    marker = rundir.stages / "dem.json"
+    done_key = str(json.loads(marker.read_text()).get("key", "")) if marker.exists() else ""
+    finished = done_key.split(":")[0] == case.hash()
+    if latest_restart(rundir.dem_restart) is None and not finished:
+        return None
+    known = set(TimeStepChoice.__dataclass_fields__)
+    return TimeStepChoice(**{k: v for k, v in record.items() if k in known})
 
 
 def dem_key(case: Case, steps: int | None) -> str:

@@ -133,10 +133,12 @@ def default_time_step(
     radius: float, density: float, youngs_modulus: float, poisson: float, impact_speed: float,
     rayleigh_fraction: float = RAYLEIGH_FRACTION,
 ) -> float:
-    """drumflow's 'auto' time step rule at a given impact speed, s.
+    """drumflow's contact time step rule at a given impact speed, s.
 
     min(fraction t_Rayleigh, t_Hertz / MIN_STEPS_PER_CONTACT), as
-    :func:`drumflow.dem.timestep.choose_time_step` does with the case's impact velocity.
+    :func:`drumflow.dem.timestep.choose_time_step` does with the case's impact velocity for
+    ``run.time_step = "contact"`` (``"auto"`` also stays below the bed's spin limit, which
+    needs a bed: these checks collide two particles).
     """
     t_r = rayleigh_time(radius, density, youngs_modulus, poisson)
     t_h = hertz_contact_time(radius, density, youngs_modulus, poisson, impact_speed)

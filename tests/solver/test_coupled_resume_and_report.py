@@ -36,6 +36,7 @@ import subprocess
 import sys
 import time
 from collections.abc import Callable
+from dataclasses import replace
 from html import unescape
 from pathlib import Path
 from typing import Any
@@ -50,6 +51,7 @@ from support.solvers import LIGGGHTS, OPENFOAM, requires_solver
 from drumflow.analysis.run_status import run_status
 from drumflow.case import Case
 from drumflow.dem.stage import restart_files
+from drumflow.dem.timestep import TimeStepChoice, choose_time_step
 from drumflow.pipeline import run_case
 from drumflow.runner import StopRun
 from drumflow.verify.resume import lifter_angle_at_resume
@@ -94,6 +96,15 @@ def _stop_after(t_stop: float) -> Callable[[str, float, float], None]:
     return progress
 
 
+#: The step the resume's stand-in for a later drumflow chooses, relative to the run's own.
+ANOTHER_STEP = 0.9
+
+
+def _another_auto_step(case: Case) -> TimeStepChoice:
+    chosen = choose_time_step(case)
+    return replace(chosen, time_step=ANOTHER_STEP * chosen.time_step)
+
+
 @pytest.fixture(scope="module")
 def runs(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
     root = tmp_path_factory.mktemp("coupled")
@@ -102,7 +113,12 @@ def runs(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
     with pytest.raises(_Interrupted):
         run_case(_case(), out["resumed"], timeout=1200, progress=_stop_after(INTERRUPT_AFTER_S))
     assert list((out["resumed"] / "dem" / "restart").glob("drum.*.restart"))
-    run_case(_case(), out["resumed"], timeout=1200)
+    with pytest.MonkeyPatch.context() as patch:
+        # Resumed as by a later drumflow whose "auto" chooses another step (as when it came to
+        # respect the spin limit): the run must go on at the step it started with.
+        patch.setattr("drumflow.dem.stage.choose_time_step", _another_auto_step)
+        patch.setattr("drumflow.pipeline.choose_time_step", _another_auto_step)
+        run_case(_case(), out["resumed"], timeout=1200)
     run_case(_case(run__processes=2), out["two_ranks"], timeout=1200)
     run_case(_case(air__mass_flow=0.2), out["faster_air"], timeout=1200)
     out["checkpointed"] = root / "checkpointed"
@@ -202,6 +218,22 @@ def test_resume_continues_the_clock_and_the_lifter_angle(runs: dict[str, Path]) 
     assert st.step == dem["steps"] and st.particles == st.particles_initial
     assert st.reached_time_s == pytest.approx(dem["steps"] * dem["time_step"], rel=1e-9)
     assert st.wall_per_simulated_s is not None and st.wall_per_simulated_s > 0
+
+
+def test_a_resumed_run_keeps_the_step_it_started_with(runs: dict[str, Path]) -> None:
+    """Regression: a resume recomputed the step from the case, so a drumflow whose "auto" had
+    changed would have started the run afresh (another air-update interval, another stage key)
+    and deleted its restarts; the run is now resumed at its own step and says what the new
+    drumflow would choose."""
+    manifest = json.loads((runs["resumed"] / "manifest.json").read_text())
+    straight = json.loads((runs["straight"] / "manifest.json").read_text())["time_step"]["time_step"]
+    assert manifest["time_step"]["time_step"] == straight
+    kept = manifest["time_step_kept"]
+    assert kept["time_step"] == straight
+    assert kept["drumflow_now_chooses"]["time_step"] == pytest.approx(ANOTHER_STEP * straight, rel=1e-12)
+    assert _dem(runs["resumed"])["resumed_from_step"] is not None
+    # The uninterrupted run never had its step kept: nothing to keep at a fresh start.
+    assert "time_step_kept" not in json.loads((runs["straight"] / "manifest.json").read_text())
 
 
 def test_resumed_run_matches_the_uninterrupted_one(runs: dict[str, Path]) -> None:

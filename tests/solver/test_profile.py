@@ -8,11 +8,13 @@ on one rank.
 from __future__ import annotations
 
 import json
+import math
 import re
 import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 import pytest
 from support.solvers import LIGGGHTS, requires_solver
@@ -134,6 +136,15 @@ def test_settings_study_from_the_restart(run: Path, tmp_path: Path) -> None:
     log = pd.read_csv(folder / "coupling" / f"rank0.{start}.csv")  # the times the loop used
     assert log["time_s"].iloc[0] == pytest.approx(start * dt_base["time_step"], rel=1e-9)
     assert spec["interval"] == 2 * dt_base["interval"]  # the same air-update period in time
+    # Regression: the deck's thermo clock (step*dt) and the profile put the half-step variant at
+    # half the restart's time; both now count from the restart's (step, time).
+    thermo = read_thermo(folder)
+    rows = thermo[thermo["step"] >= start]
+    expected = start * dt_base["time_step"] + (rows["step"] - start) * spec["time_step"]
+    assert np.allclose(rows["time"], expected, rtol=1e-9, atol=1e-12)
+    from drumflow.bench.profile import profile_run
+    loops = profile_run(folder.parent, window_s=math.inf).loops
+    assert loops["start_time_s"].min() == pytest.approx(start * dt_base["time_step"], rel=1e-9)
     meta = json.loads(out.with_suffix(".json").read_text())
     assert meta["steps"] == 100 and meta["machine"]["cpus"] >= 1 and meta["resumed"] == []
 

@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from drumflow.case import load_case
+from drumflow.case import Case, load_case
 from drumflow.dem.impacts import (
     WALL_EQUIVALENT_SPEED_FACTOR,
     ImpactSample,
@@ -176,13 +176,17 @@ def test_implied_step_scales_as_v_to_minus_one_fifth() -> None:
         implied_time_steps([0.0], **MATERIAL)
 
 
-def test_design_speed_gives_back_the_paper_cases_step() -> None:
-    case = load_case(CASES / "paper_model_two.toml")
+def test_design_speed_gives_back_the_paper_cases_contact_step() -> None:
+    """The contact step ("contact", and "auto" before the spin limit) is 10 steps in the
+    free-fall contact; "auto" is now shorter, set by the bed's spin limit."""
+    data = load_case(CASES / "paper_model_two.toml").model_dump(mode="json")
+    data["run"]["time_step"] = "contact"
+    case = Case.model_validate(data)
     choice = choose_time_step(case)
     p = case.particles
     dt = implied_time_steps([impact_velocity(case)], p.radius, p.density, p.youngs_modulus,
                             p.poisson_ratio)[0]
-    assert choice.steps_per_contact == pytest.approx(10.0)  # the Hertz cap binds today
+    assert choice.steps_per_contact == pytest.approx(10.0) and choice.bound == "contact"
     assert dt == pytest.approx(choice.time_step, rel=1e-12)
 
 

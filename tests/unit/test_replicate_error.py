@@ -4,7 +4,6 @@ another case is refused."""
 
 from __future__ import annotations
 
-import importlib.util
 import json
 import shutil
 from pathlib import Path
@@ -12,6 +11,7 @@ from types import ModuleType
 
 import pandas as pd
 import pytest
+from support.scripts import load_script
 
 ROOT = Path(__file__).resolve().parents[2]
 SHIPPED = ROOT / "results" / "paper" / "model_one"
@@ -19,11 +19,7 @@ PARCELS = ROOT / "results" / "paper_parcels" / "model_one"
 
 
 def _script() -> ModuleType:
-    spec = importlib.util.spec_from_file_location("replicate_error", ROOT / "scripts" / "replicate_error.py")
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return load_script("replicate_error")
 
 
 def test_a_run_against_itself_and_against_a_shifted_copy(tmp_path: Path) -> None:
@@ -74,3 +70,26 @@ def test_progress_of_one_run_over_all_it_reached(tmp_path: Path) -> None:
     out = tmp_path / "out"
     assert script.main([str(SHIPPED), str(SHIPPED), str(out), "--until", "2.0", "--progress"]) == 0
     assert len(pd.read_csv(out / "progress.csv")) == 8 and len(pd.read_csv(out / "replicate.csv")) == 4
+
+
+@pytest.mark.parametrize("window", ["0", "-0.5", "nan"])
+def test_a_window_that_is_not_positive_is_refused_by_name(tmp_path: Path, window: str) -> None:
+    script = _script()
+    with pytest.raises(ValueError, match=r"--window = .* s: must be positive"):
+        script.progress(SHIPPED, float(window))
+    out = tmp_path / "out"
+    assert script.main([str(SHIPPED), str(SHIPPED), str(out), "--window", window]) == 2
+    assert not out.exists()
+
+
+def test_two_settings_compare_only_in_the_fields_named(tmp_path: Path) -> None:
+    """--differ names the fields two runs may differ in (the spin study: the time step)."""
+    spin = ROOT / "results" / "bench" / "paper_model_two_spin"
+    half, default = spin / "half_step", spin / "default_step"
+    script = _script()
+    with pytest.raises(ValueError, match=r"differ in name, run\.time_step"):
+        script.compare(half, default, 2.0, 1.0)
+    with pytest.raises(ValueError, match=r"differ in run\.time_step"):
+        script.compare(half, default, 2.0, 1.0, ("name",))
+    table, summary = script.compare(half, default, 2.0, 1.0, ("name", "run.time_step"))
+    assert summary["differ_in"] == ["name", "run.time_step"] and len(table) == 2

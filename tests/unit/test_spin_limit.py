@@ -10,8 +10,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from drumflow.case import load_case
-from drumflow.dem.timestep import bed_contact_overlap, spin_mode, verlet_damping_limit
+from drumflow.case import Case, load_case
+from drumflow.dem.timestep import (
+    SPIN_LIMIT_FRACTION,
+    bed_contact_overlap,
+    bed_spin_mode,
+    choose_time_step,
+    spin_mode,
+    verlet_damping_limit,
+)
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -69,23 +76,61 @@ def test_one_contact_mode_by_hand() -> None:
         spin_mode(r, 1050.0, 517e3, 0.45, 1.0, delta)
 
 
-def test_the_paper_beds_overlap_and_their_default_step() -> None:
+def _contact_step(case: Case) -> Case:
+    """The case with ``run.time_step = "contact"``: the step before "auto" knew the spin limit."""
+    data = case.model_dump(mode="json")
+    data["run"]["time_step"] = "contact"
+    return Case.model_validate(data)
+
+
+def test_the_paper_beds_overlap_and_the_steps() -> None:
     """The bed's weight gives model one's contacts about a fifth of a radius (the stability
-    monitor's reading in the full run); the default step (10 per Hertz contact at the
-    free-fall speed) is then 1.6 times the bed's spin limit, and half of it is below."""
+    monitor's reading in the full run); the contact step (10 per Hertz contact at the free-fall
+    speed, "auto" until the spin limit entered it) is then 1.6 times the bed's spin limit, half
+    of it is below, and "auto" is SPIN_LIMIT_FRACTION of the limit at its own step."""
     from drumflow.dem.restitution import calibrate_case
-    from drumflow.dem.stage import plan_run
 
     case = load_case(ROOT / "cases" / "paper_model_one.toml")
     p = case.particles
     overlap = bed_contact_overlap(case)
     assert 0.15 < overlap / p.radius < 0.25
-    _, plan = plan_run(case)
+    contact = choose_time_step(_contact_step(case))
+    assert contact.bound == "contact" and contact.steps_per_contact == pytest.approx(10.0)
     for factor, low, high in ((1.0, 1.5, 1.7), (0.5, 0.75, 0.9)):
-        dt = factor * plan.time_step
+        dt = factor * contact.time_step
         e = calibrate_case(case, dt)["particle_particle"].liggghts_value
         limit = spin_mode(p.radius, p.density, p.youngs_modulus, p.poisson_ratio, e, overlap).time_step_limit
         assert low < dt / limit < high
+    auto = choose_time_step(case)
+    assert auto.mode == "auto" and auto.bound == "spin"
+    limit = bed_spin_mode(case, auto.time_step).time_step_limit
+    assert auto.time_step == pytest.approx(SPIN_LIMIT_FRACTION * limit, rel=1e-6)
+    assert auto.spin_time_step_limit == pytest.approx(auto.time_step / SPIN_LIMIT_FRACTION, rel=1e-6)
+    # Still every contact resolved, and about half the old step (the cost of the fix).
+    assert auto.steps_per_contact > 20.0 and 0.45 < auto.time_step / contact.time_step < 0.55
+
+
+@pytest.mark.parametrize("name", ["paper_model_two.toml", "smoke.toml"])
+def test_auto_stays_below_the_spin_limit_and_contact_does_not(name: str) -> None:
+    case = load_case(ROOT / "cases" / name)
+    auto, contact = choose_time_step(case), choose_time_step(_contact_step(case))
+    assert auto.spin_time_step_limit is not None and contact.spin_time_step_limit is not None
+    assert auto.time_step <= SPIN_LIMIT_FRACTION * auto.spin_time_step_limit * (1 + 1e-9)
+    assert contact.time_step > contact.spin_time_step_limit  # the shipped cases need the cap
+    assert contact.mode == "contact" and auto.time_step < contact.time_step
+
+
+def test_a_soft_shallow_bed_keeps_the_contact_step() -> None:
+    """Where the spin limit is not the tighter bound, "auto" is the contact step: the cap only
+    ever shortens the step. A stiff particle barely overlaps, so its spin mode is slow enough."""
+    case = load_case(ROOT / "cases" / "smoke.toml")
+    data = case.model_dump(mode="json")
+    data["particles"]["youngs_modulus"] = 5.0e9
+    data["run"]["rayleigh_fraction"] = 0.05
+    stiff = Case.model_validate(data)
+    auto = choose_time_step(stiff)
+    assert auto.bound == "rayleigh"
+    assert auto.time_step == pytest.approx(choose_time_step(_contact_step(stiff)).time_step)
 
 
 def test_the_shipped_study_shows_the_numerical_spin_and_its_cause() -> None:
@@ -106,3 +151,25 @@ def test_the_shipped_study_shows_the_numerical_spin_and_its_cause() -> None:
     energy = pd.read_csv(ROOT / "results" / "bench" / "paper_model_one_spin" / "long_run" / "energy.csv")
     formed = energy[energy["time_s"] >= 0.25]
     assert formed["rotational_kinetic_energy_J"].between(1.8, 2.7).all()
+
+
+def test_the_whole_run_study_shows_the_old_steps_bias_on_the_flow() -> None:
+    """results/bench/paper_model_two_spin (the README's table): over 17.5 s of model two's
+    parcels, the cascading bed's flow at the old step (1.61 x the spin limit) is above the half
+    step's by more than twice the half step's noise floor, in both runs at the old step, which
+    agree with each other within 1 %; the heat answers agree within 0.1 %."""
+    import json
+
+    spin = ROOT / "results" / "bench" / "paper_model_two_spin"
+    ladder = json.loads((spin / "ladder.json").read_text())
+    assert ladder["reference"] == "half_step"
+    rungs = {r["rung"]: r for r in ladder["rungs"]}
+    floor = ladder["noise_floor"]["steady_mass_flow"]
+    for name in ("default_step", "default_step_replicate"):
+        assert rungs[name]["error_steady_mass_flow"] > max(2.0 * floor, 0.04)
+        assert abs(rungs[name]["error_h"]) < 1e-3 and abs(rungs[name]["error_temperature"]) < 1e-3
+    old, replicate = (rungs[n]["value_steady_mass_flow"] for n in ("default_step", "default_step_replicate"))
+    assert abs(replicate / old - 1.0) < 0.01
+    steps = {n: json.loads((spin / n / "manifest.json").read_text())["time_step"]["time_step"]
+             for n in ("half_step", "default_step")}
+    assert steps["half_step"] == pytest.approx(0.5 * steps["default_step"], rel=1e-9)

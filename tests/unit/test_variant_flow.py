@@ -4,13 +4,13 @@ stopped before the interval's end is refused."""
 
 from __future__ import annotations
 
-import importlib.util
 import json
 from pathlib import Path
 from types import ModuleType
 
 import numpy as np
 import pytest
+from support.scripts import load_script
 
 from drumflow.case import case_to_toml, load_case
 
@@ -19,11 +19,7 @@ DT = 1e-3
 
 
 def _script() -> ModuleType:
-    spec = importlib.util.spec_from_file_location("variant_flow", ROOT / "scripts" / "variant_flow.py")
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return load_script("variant_flow")
 
 
 def _crossings(path: Path, times: np.ndarray) -> None:
@@ -70,3 +66,14 @@ def test_a_run_that_stopped_inside_the_interval_is_refused(tmp_path: Path) -> No
     _crossings(run / "dem" / "coupling" / "crossings.csv", np.full(3, 1.05))
     with pytest.raises(ValueError, match="before"):
         _script().flows(study, run, 0.1)
+
+
+@pytest.mark.parametrize("window", [0.0, -0.05, float("nan")])
+def test_a_window_that_is_not_positive_is_refused_by_name(tmp_path: Path, window: float) -> None:
+    study, run, _ = _study(tmp_path)
+    with pytest.raises(ValueError, match=r"--window = .* s: must be positive"):
+        _script().flows(study, run, window)
+    # From the command line: one line on stderr, exit code 2, nothing written.
+    out = tmp_path / "out"
+    assert _script().main([str(study), str(out), "--window", str(window)]) == 2
+    assert not out.exists()
