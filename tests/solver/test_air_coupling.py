@@ -67,15 +67,20 @@ def test_smoke_drum_with_uniform_air_cools_and_closes_energy(tmp_path: Path) -> 
 
     spec = json.loads((tmp_path / "run" / "dem" / "coupling.json").read_text())
     thermo = read_thermo(tmp_path / "run" / "dem")
-    every = int(spec["overlap_every"])
-    on = thermo[thermo["step"] % every == 0]
-    # Rows of runs that end on a multiple, and of the last run, carry it too.
-    last_run = thermo["step"].max() - int(spec["interval"])
-    ends_on = (thermo["step"] // every + 1) * every - thermo["step"] < int(spec["interval"])
-    off = thermo[(thermo["step"] % every != 0) & (thermo["step"] < last_run) & ~ends_on]
+    every, interval = int(spec["overlap_every"]), int(spec["interval"])
+    # The loop runs `interval` steps at a time from step 0, and switches the column on for a
+    # whole run that reaches a multiple of `every`, and for the last run. A row closes the run
+    # it ends (read_thermo keeps a step's first row). Regression: the test took only rows at or
+    # just before a multiple as evaluated, which held while `every` was a multiple of
+    # `interval` and failed when the spin-limited step changed both.
+    step = thermo["step"]
+    run_start = ((step - 1) // interval) * interval
+    evaluated = ((run_start + interval) // every > run_start // every) | (step > step.max() - interval)
+    on, off = thermo[evaluated & (step > 0)], thermo[~evaluated & (step > 0)]
     assert len(on) >= 3 and len(off) >= 3 * len(on) // 2
+    assert step[(step > 0) & (step % every == 0)].isin(on["step"]).all()  # every multiple is on
     # A bed: contacts overlap (at step 0 the particles are placed apart: LIGGGHTS' max of none).
-    assert (on.loc[on["step"] > 0, "overlap_max"] > 0.0).all()
+    assert (on["overlap_max"] > 0.0).all()
     assert off["overlap_max"].isna().all()
 
 
