@@ -220,8 +220,9 @@ def choose_time_step(case: Case) -> TimeStepChoice:
     """The DEM time step for a case: for ``run.time_step = "auto"`` the largest step that keeps
     :data:`MIN_STEPS_PER_CONTACT` steps in the fastest contact, stays below
     ``run.rayleigh_fraction`` of the Rayleigh time and below :data:`SPIN_LIMIT_FRACTION` of the
-    bed's spin limit; ``"contact"`` leaves out the spin limit (faster for stiff-contact beds,
-    with a numerical spin, README 'The spin limit'); a number is the user's step.
+    bed's spin limit; ``"contact"`` leaves out the spin limit (faster where it binds, in beds
+    of soft, deeply overlapping particles, whose spin is then numerical: README 'The spin
+    limit'); a number is the user's step.
 
     Raises
     ------
