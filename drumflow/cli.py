@@ -9,6 +9,7 @@ interrupted (rerun the same command to resume).
 from __future__ import annotations
 
 import json
+import math
 import signal
 import sys
 import time
@@ -234,6 +235,12 @@ def status(
         table.add_row("a resume starts from", f"restart of step {st.restart_step:,} "
                       f"({st.restart_time_s:.3f} s)" if st.restart_time_s is not None
                       else f"restart of step {st.restart_step:,}")
+    if st.time_step_s is not None:
+        kept = ("" if st.new_run_time_step_s is None
+                or math.isclose(st.new_run_time_step_s, st.time_step_s, rel_tol=1e-9)
+                else f"; kept on resume: a new run of this case would take {st.new_run_time_step_s:.3g} s "
+                "(README, 'The spin limit')")
+        table.add_row("time step", f"{st.time_step_s:.3g} s{kept}")
     table.add_row("disk", f"{st.output_bytes / 1e9:.2f} GB output, {st.restart_bytes / 1e9:.2f} GB in "
                   f"{st.restarts} restart file(s)")
     console.print(table)

@@ -18,13 +18,16 @@ import socket
 import time
 from dataclasses import asdict, dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from drumflow.coupling.log import read_coupling, update_walls
 from drumflow.coupling.spec import STOPPED_RECORD
 from drumflow.dem.stage import restart_files
 from drumflow.dem.thermo import COLUMNS, ThermoParser, log_files
-from drumflow.errors import MissingRunFileError
+from drumflow.errors import DrumflowError, MissingRunFileError
+
+if TYPE_CHECKING:
+    from drumflow.case import Case
 
 #: Updates the recent pace is taken over: about two minutes of model one, long enough to even
 #: out a slow update, short enough to follow the fall in pace as the curtain forms.
@@ -73,6 +76,10 @@ class RunStatus:
     stopped_on_request_s
         Where the coupling loop wrote its restart when it was last asked to stop (``drumflow
         stop``, an interrupt, a SLURM time-limit warning), s; None if the last attempt was not.
+    time_step_s, new_run_time_step_s
+        The run's DEM step (it keeps it when resumed) and the step a new run of the same case
+        would take with this drumflow (they differ for a run started before "auto" came to
+        respect the spin limit); None before the DEM stage has chosen one.
     """
 
     run_dir: str
@@ -94,6 +101,8 @@ class RunStatus:
     restart_bytes: int
     output_bytes: int
     stopped_on_request_s: float | None = None
+    time_step_s: float | None = None
+    new_run_time_step_s: float | None = None
 
     @property
     def running(self) -> bool:
@@ -231,4 +240,17 @@ def run_status(run_dir: Path | str, now: float | None = None) -> RunStatus:
         restart_bytes=restart_bytes,
         output_bytes=total - restart_bytes,
         stopped_on_request_s=_stopped_on_request(dem),
+        time_step_s=float(time_step) if time_step else None,
+        new_run_time_step_s=_new_run_time_step(case) if time_step else None,
     )
+
+
+def _new_run_time_step(case: Case) -> float | None:
+    """The step this drumflow would give a new run of ``case``; None where it would refuse the
+    case now (the status of an existing run must still be readable)."""
+    from drumflow.dem.timestep import choose_time_step
+
+    try:
+        return choose_time_step(case.dem_case()).time_step
+    except DrumflowError:
+        return None

@@ -95,6 +95,22 @@ def test_a_finished_run_has_no_eta_and_the_cli_prints_it(tmp_path: Path) -> None
     assert data["reached_time_s"] == pytest.approx(3.0) and data["restarts"] == 2
 
 
+def test_the_status_names_the_runs_step_and_what_a_new_run_would_take(tmp_path: Path) -> None:
+    """A run keeps its step when resumed (drumflow.dem.stage.kept_time_step); the status says
+    so when this drumflow would give a new run of the case another step (here the hand-written
+    run's 1e-4 s against the smoke case's spin-limited "auto")."""
+    from drumflow.dem.timestep import choose_time_step
+
+    run = _write_run(tmp_path / "run", last_step=2500, update_walls=[2.0] * 5)
+    st = run_status(run)
+    new = choose_time_step(load_case(ROOT / "cases" / "smoke.toml")).time_step
+    assert st.time_step_s == DT and st.new_run_time_step_s == pytest.approx(new)
+    result = CliRunner(env={"COLUMNS": "200"}).invoke(app, ["status", str(run)])
+    assert result.exit_code == 0, result.output
+    assert "0.0001 s; kept on resume: a new run of this case would take" in result.output
+    assert f"{new:.3g} s" in result.output
+
+
 def test_not_a_run_directory(tmp_path: Path) -> None:
     with pytest.raises(MissingRunFileError, match="manifest"):
         run_status(tmp_path)
