@@ -267,13 +267,19 @@ class RunDir:
     def _marker(self, stage: str) -> Path:
         return self.stages / f"{stage}.json"
 
+    def _finished(self, stage: str) -> dict[str, Any] | None:
+        path = self._marker(stage)
+        return json.loads(path.read_text()) if path.exists() else None
+
     def stage_done(self, stage: str, key: str) -> dict[str, Any] | None:
         """The stage's recorded result if it finished with the same input ``key``."""
-        path = self._marker(stage)
-        if not path.exists():
-            return None
-        data = json.loads(path.read_text())
-        return data if data.get("key") == key else None
+        data = self._finished(stage)
+        return data if data is not None and data.get("key") == key else None
+
+    def finished_key(self, stage: str) -> str | None:
+        """The input key the stage last finished with, or None if it has not finished."""
+        data = self._finished(stage)
+        return None if data is None else str(data.get("key", ""))
 
     def mark_done(self, stage: str, key: str, result: dict[str, Any], wall_time_s: float) -> None:
         """Record a finished stage with its input key, result and timing."""

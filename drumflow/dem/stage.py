@@ -183,9 +183,7 @@ def kept_time_step(case: Case, rundir: RunDir, steps: int | None = None) -> Time
     key = str(rundir.manifest.get("dem_key", ""))
     if steps is not None or not record or ":steps=" in key or key.split(":")[0] != case.hash():
         return None
-    marker = rundir.stages / "dem.json"
-    done_key = str(json.loads(marker.read_text()).get("key", "")) if marker.exists() else ""
-    finished = done_key.split(":")[0] == case.hash()
+    finished = (rundir.finished_key("dem") or "").split(":")[0] == case.hash()
     if latest_restart(rundir.dem_restart) is None and not finished:
         return None
     known = set(TimeStepChoice.__dataclass_fields__)
