@@ -50,13 +50,28 @@ def _load(case_file: Path) -> Any:
     return load_case(case_file)
 
 
+def _load_profiled(case_file: Path, fast: bool) -> Any:
+    """The case, under the fast profile on ``--fast`` (what it changed printed)."""
+    case = _load(case_file)
+    if not fast:
+        return case
+    from drumflow.case import fast_profile
+
+    case, changed = fast_profile(case)
+    err_console.print(f"fast profile, as case {case.name}: " + ("; ".join(changed) or "nothing to change"))
+    return case
+
+
 @app.command()
-def check(case_file: Annotated[Path, typer.Argument(help="case file (TOML)")]) -> None:
+def check(
+    case_file: Annotated[Path, typer.Argument(help="case file (TOML)")],
+    fast: Annotated[bool, typer.Option("--fast", help="check it under the fast profile")] = False,
+) -> None:
     """Validate a case file without running anything."""
     from drumflow.dem.timestep import choose_time_step
     from drumflow.pipeline import refuse_unavailable
 
-    case = _load(case_file)
+    case = _load_profiled(case_file, fast)
     refuse_unavailable(case)
     moved = case.dem_case()  # the parcels under particles.coarse_grain: they set the step
     choice = choose_time_step(moved)
@@ -80,7 +95,10 @@ def check(case_file: Annotated[Path, typer.Argument(help="case file (TOML)")]) -
         verdict = (f"resolved (the step is {ratio:.2f}× it)" if ratio <= 1.0 else
                    f"the step is {ratio:.2f}× it: the particles' spin in the bed is numerical "
                    "(README, 'The spin limit')")
-        table.add_row("spin limit", f"{choice.spin_time_step_limit:.3g} s for the bed's contacts; {verdict}")
+        dashpot = ("" if case.contacts.tangential_damping else
+                   " (contacts.tangential_damping = false: the tangential spring's own)")
+        table.add_row("spin limit", f"{choice.spin_time_step_limit:.3g} s for the bed's contacts{dashpot}; "
+                      f"{verdict}")
     console.print(table)
 
 
@@ -95,11 +113,15 @@ def run(
     timeout: Annotated[float | None, typer.Option("--timeout", min=1, help="solver time limit, s")] = None,
     force: Annotated[bool, typer.Option("--force", help="reuse a directory of another case")] = False,
     as_json: Annotated[bool, typer.Option("--json", help="print the summary as JSON")] = False,
+    fast: Annotated[bool, typer.Option(
+        "--fast", help="the fast profile: no tangential dashpot between particles (the contact "
+        "step without numerical spin), no conduction, the converged stop (README, 'The fast "
+        "profile'); runs as case NAME_fast")] = False,
 ) -> None:
     """Run a case end to end (geometry, DEM, observables, plots) into a run directory."""
     from drumflow.pipeline import run_case
 
-    case = _load(case_file)
+    case = _load_profiled(case_file, fast)
     out = out or Path("runs") / case.name
     try:
         with StageProgress(err_console) as progress:

@@ -193,6 +193,11 @@ VARIANTS: list[Variant] = [
             no_tangential_damping=True),
     Variant("conservative_grid_x", "conservative, on the processor grid across the drum (x)",
             time_step_factor=0.5, moving_shell=True, processors="{np} 1 1", min_ranks=2),
+    # The fast profile (README, 'The fast profile') from a run at the contact step: what
+    # `drumflow run --fast` changes in the deck, side by side with half_step (the 'auto' step).
+    Variant("fast", "the fast profile: tangential dashpot off between particles and conduction "
+            "off, at the run's step (the contact step)", no_tangential_damping=True,
+            no_conduction=True),
 ]
 
 #: Mean temperature after the steps: within this fraction of the baseline's change over them...

@@ -225,6 +225,7 @@ def deck_context(
         "mu_pw": f"{cc.particle_wall.friction:.6g}",
         "mur_pp": f"{cc.particle_particle.rolling_friction:.6g}",
         "mur_pw": f"{cc.particle_wall.rolling_friction:.6g}",
+        "tangential_damping": cc.tangential_damping,
         # LIGGGHTS' conduction is sqrt(2 pi) times Eq. 24's for the same k (a pure geometric
         # factor: sqrt of the overlap area against the Hertzian contact radius), and k enters
         # linearly, so LIGGGHTS gets k / sqrt(2 pi). See drumflow.verify.contacts.

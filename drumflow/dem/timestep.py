@@ -91,7 +91,8 @@ class SpinMode:
 
 
 def spin_mode(radius: float, density: float, youngs_modulus: float, poisson: float,
-              restitution: float, overlap: float, contacts: int = BED_CONTACTS) -> SpinMode:
+              restitution: float, overlap: float, contacts: int = BED_CONTACTS,
+              damped: bool = True) -> SpinMode:
     """The spin of a particle against ``contacts`` equal neighbours spinning the other way, the
     fastest rotational mode of a packed bed, with LIGGGHTS' Hertz tangential spring and dashpot.
 
@@ -105,7 +106,9 @@ def spin_mode(radius: float, density: float, youngs_modulus: float, poisson: flo
     (:func:`verlet_damping_limit`). Above that step the dashpot excites the spin at every step
     until the contact slides (Coulomb): a numerical spin the bed keeps. For ``contacts = 1``
     this is two particles spinning the same way on one contact, which LIGGGHTS reproduces
-    (tests/solver/test_spin_liggghts.py).
+    (tests/solver/test_spin_liggghts.py). Without the dashpot (``damped = False``,
+    ``contacts.tangential_damping = false``) the spring alone limits the step, at
+    ``omega dt = 2``, about twice as far: LIGGGHTS reproduces that too.
 
     Parameters
     ----------
@@ -117,6 +120,8 @@ def spin_mode(radius: float, density: float, youngs_modulus: float, poisson: flo
         Normal overlap of the contacts, m (:func:`bed_contact_overlap`).
     contacts
         Contacts per particle.
+    damped
+        Whether the contacts have the tangential dashpot (LIGGGHTS' default).
     """
     if not 0.0 < restitution < 1.0:
         raise ValueError(f"restitution = {restitution!r}: must be in (0, 1)")
@@ -132,7 +137,7 @@ def spin_mode(radius: float, density: float, youngs_modulus: float, poisson: flo
     beta = abs(log_e) / math.sqrt(log_e**2 + math.pi**2)
     g_t = 2.0 * math.sqrt(5.0 / 6.0) * beta * math.sqrt(k_t * 0.5 * mass)
     omega = math.sqrt(2.0 * contacts * k_t * arm**2 / inertia)
-    zeta = 2.0 * contacts * g_t * arm**2 / inertia / (2.0 * omega)
+    zeta = 2.0 * contacts * g_t * arm**2 / inertia / (2.0 * omega) if damped else 0.0
     return SpinMode(omega, zeta, verlet_damping_limit(zeta) / omega)
 
 
@@ -159,13 +164,15 @@ def bed_contact_overlap(case: Case) -> float:
 def bed_spin_mode(case: Case, time_step: float) -> SpinMode:
     """:func:`spin_mode` of the case's particle-particle contacts at the bottom of its bed
     (:func:`bed_contact_overlap`), with the restitution coefficient a run at ``time_step``
-    gives LIGGGHTS (:func:`drumflow.dem.restitution.calibrate_case`)."""
+    gives LIGGGHTS (:func:`drumflow.dem.restitution.calibrate_case`), with or without the
+    tangential dashpot as the case has it (``contacts.tangential_damping``)."""
     from drumflow.dem.restitution import calibrate_case  # it imports this module
 
     p = case.particles
     coefficient = calibrate_case(case, time_step)["particle_particle"].liggghts_value
     return spin_mode(p.radius, p.density, p.youngs_modulus, p.poisson_ratio, coefficient,
-                     min(bed_contact_overlap(case), 0.5 * p.radius))
+                     min(bed_contact_overlap(case), 0.5 * p.radius),
+                     damped=case.contacts.tangential_damping)
 
 
 @dataclass(frozen=True)

@@ -120,6 +120,33 @@ def test_auto_stays_below_the_spin_limit_and_contact_does_not(name: str) -> None
     assert contact.mode == "contact" and auto.time_step < contact.time_step
 
 
+@pytest.mark.parametrize("name", ["paper_model_one.toml", "paper_model_two.toml", "smoke.toml"])
+def test_without_the_dashpot_auto_is_the_contact_step_again(name: str) -> None:
+    """``contacts.tangential_damping = false``: the bed's spin mode is undamped, its limit the
+    spring's ``omega dt = 2`` (:func:`verlet_damping_limit` at zeta 0), more than twice the
+    dashpot's, and above the contact step in the shipped cases, so "auto" is the contact step;
+    the deck says ``tangential_damping off`` on the pair style (and not on the walls)."""
+    from drumflow.dem.deck import deck_context, plan_steps, render_deck
+
+    case = load_case(ROOT / "cases" / name)
+    data = case.model_dump(mode="json")
+    data["contacts"]["tangential_damping"] = False
+    free = Case.model_validate(data)
+    choice, contact = choose_time_step(free), choose_time_step(_contact_step(case))
+    mode = bed_spin_mode(free, choice.time_step)
+    assert mode.damping_ratio == 0.0
+    assert choice.spin_time_step_limit == pytest.approx(2.0 / mode.frequency)
+    assert choice.spin_time_step_limit > 2.0 * bed_spin_mode(case, choice.time_step).time_step_limit
+    assert choice.bound in ("contact", "rayleigh") and choice.time_step == pytest.approx(contact.time_step)
+    assert free.hash() != case.hash()
+    deck = render_deck(deck_context(free, plan_steps(free, choice)))
+    lines = [line for line in deck.splitlines()
+             if "tangential_damping off" in line and not line.startswith("#")]
+    assert len(lines) == 1 and lines[0].startswith("pair_style"), lines
+    damped = render_deck(deck_context(case, plan_steps(case, choose_time_step(case))))
+    assert "tangential_damping off" not in damped
+
+
 def test_a_soft_shallow_bed_keeps_the_contact_step() -> None:
     """Where the spin limit is not the tighter bound, "auto" is the contact step: the cap only
     ever shortens the step. A stiff particle barely overlaps, so its spin mode is slow enough."""
@@ -173,3 +200,26 @@ def test_the_whole_run_study_shows_the_old_steps_bias_on_the_flow() -> None:
     steps = {n: json.loads((spin / n / "manifest.json").read_text())["time_step"]["time_step"]
              for n in ("half_step", "default_step")}
     assert steps["half_step"] == pytest.approx(0.5 * steps["default_step"], rel=1e-9)
+
+
+def test_the_fast_profile_run_lands_on_the_resolved_spins_answers() -> None:
+    """results/bench/paper_model_two_spin/fast (README, 'The fast profile'): without the
+    tangential dashpot, at the old (contact) step, the three answers over 17.5 s are within the
+    half step's noise floor and 1 % of it (the old step with the dashpot: +5.5 %), and the run
+    took the old step, the dashpot off and no conduction, as its manifest records."""
+    import json
+
+    spin = ROOT / "results" / "bench" / "paper_model_two_spin"
+    ladder = json.loads((spin / "ladder.json").read_text())
+    rungs = {r["rung"]: r for r in ladder["rungs"]}
+    floor = ladder["noise_floor"]["steady_mass_flow"]
+    fast = rungs["fast"]
+    assert abs(fast["error_steady_mass_flow"]) < min(floor, 0.01)
+    assert abs(fast["error_h"]) < 1e-3 and abs(fast["error_temperature"]) < 1e-3
+    assert fast["speedup"] > 1.3
+    manifest = json.loads((spin / "fast" / "manifest.json").read_text())
+    old = json.loads((spin / "default_step" / "manifest.json").read_text())
+    assert manifest["case"]["contacts"]["tangential_damping"] is False
+    assert manifest["case"]["run"]["conduction"] is False
+    assert manifest["time_step"]["time_step"] == pytest.approx(old["time_step"]["time_step"], rel=1e-9)
+    assert manifest["time_step"]["bound"] == "contact"
