@@ -42,7 +42,7 @@ from drumflow.dem.stage import (
     plan_run,
 )
 from drumflow.dem.thermo import read_thermo
-from drumflow.dem.timestep import choose_time_step
+from drumflow.dem.timestep import TimeStepChoice, choose_time_step
 from drumflow.errors import CaseError, RunDirectoryError
 from drumflow.report.plots import (
     plot_air_heat,
@@ -67,6 +67,18 @@ def refuse_unavailable(case: Case) -> None:
                 "available in this version; allowed: false"
             ]
         )
+
+
+def kept_step_rule(case: Case, kept: TimeStepChoice) -> str:
+    """The rule a kept step follows today, for the run's ``skips`` record: a step an older
+    "auto" chose is today's ``"contact"`` rule when it equals that rule's step (the "auto"
+    before the spin limit), else its recorded mode."""
+    data = case.model_dump(mode="json")
+    data["run"]["time_step"] = "contact"
+    contact = choose_time_step(Case.model_validate(data))
+    if kept.mode == "auto" and math.isclose(contact.time_step, kept.time_step, rel_tol=1e-9):
+        return "contact"
+    return kept.mode
 
 
 def run_case(
@@ -124,6 +136,7 @@ def run_case(
     # both use them. A run being resumed keeps the step it started with.
     kept = kept_time_step(moved, rundir, steps)
     choice, plan = plan_run(moved, steps, kept)
+    step_rule = choice.mode
     if kept is not None:
         now = choose_time_step(moved)
         if not math.isclose(now.time_step, kept.time_step, rel_tol=1e-12):
@@ -131,9 +144,10 @@ def run_case(
                 "time_step": kept.time_step, "drumflow_now_chooses": now.as_dict(),
                 "why": "a run keeps the step it started with; start it afresh in another "
                        "directory for the new step"})
+            step_rule = kept_step_rule(moved, kept)
     nprocs = runner.profile.processes_for(moved)
     coupling = _air(case, rundir, runner, nprocs, plan.time_step, plan.dump_every, progress)
-    rundir.record("skips", skips(moved, choice.mode, coupling is not None, shape.wall_motion, nprocs))
+    rundir.record("skips", skips(moved, step_rule, coupling is not None, shape.wall_motion, nprocs))
     inputs = DemInputs(shape, choice, plan, processes=nprocs, coupling=coupling, steps=steps,
                        timeout=timeout, progress=progress)
     result = dem.run(moved, rundir, runner, inputs)

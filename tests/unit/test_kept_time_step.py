@@ -66,3 +66,21 @@ def test_no_step_is_kept_where_the_run_starts_afresh(tmp_path: Path) -> None:
     assert kept_time_step(CASE, _run_dir(tmp_path / "d", key_suffix=":steps=40")) is None
     # A new directory.
     assert kept_time_step(CASE, RunDir(tmp_path / "e")) is None
+
+
+def test_a_kept_step_of_the_older_auto_is_recorded_as_the_contact_rule() -> None:
+    """Regression: model one's long run, started when "auto" was the contact rule, recorded on
+    resume the spin-limited "auto" skip ("not measured") though it runs the contact step. Its
+    skips now name the rule its step follows today."""
+    from drumflow.pipeline import kept_step_rule
+    from drumflow.skips import skips
+
+    data = CASE.model_dump(mode="json")
+    data["run"]["time_step"] = "contact"
+    contact = choose_time_step(type(CASE).model_validate(data))
+    older_auto = replace(contact, mode="auto", bound=None, spin_time_step_limit=None)
+    assert kept_step_rule(CASE, older_auto) == "contact"
+    assert kept_step_rule(CASE, replace(older_auto, time_step=0.7 * contact.time_step)) == "auto"
+    entries = [e["skip"] for e in skips(CASE, kept_step_rule(CASE, older_auto), False, "static_shell", 1)]
+    assert any(e.startswith("time step 'contact'") for e in entries)
+    assert not any(e.startswith("time step 'auto'") for e in entries)
