@@ -82,6 +82,18 @@ def ladder(case: Case) -> list[Rung]:
     for f in (0.10, 0.20, 0.30, 0.40):
         rungs.append(Rung(f"dt_{round(f * 100)}pct", "time_step",
                           f"time step {f:.0%} of the Rayleigh time (static shell)", rayleigh_fraction=f))
+    # The rule "auto" was until it respected the bed's spin limit, and the two ways back to its
+    # step: without the tangential dashpot (no spin limit below the spring's), and the whole
+    # fast profile (README, 'The fast profile'; at the case's fixed time, so that its errors
+    # are those of the settings, not of where the converged stop fired).
+    rungs.append(Rung("contact", "time_step", "time step 'contact': 10 steps per contact, "
+                      "without the spin limit", {"run.time_step": "contact"}))
+    rungs.append(Rung("no_tangential_damping", "contacts", "no tangential dashpot between "
+                      "particles ('auto' then takes the contact step)",
+                      {"contacts.tangential_damping": False}))
+    rungs.append(Rung("fast", "profile", "the fast profile's settings (no tangential dashpot, no "
+                      "conduction) at the fixed time",
+                      {"contacts.tangential_damping": False, "run.conduction": False}))
     rungs.append(Rung("moving_mesh", "walls", "moving-mesh shell at the default time step",
                       {"run.wall_motion": "moving_mesh"}))
     for s in (0.5, 0.2):

@@ -46,6 +46,21 @@ def test_time_step_rungs_are_fractions_of_the_rayleigh_time(smoke) -> None:
     assert choice.mode == "forced"  # 40% is past drumflow's limit: the ladder measures beyond it
 
 
+def test_the_contact_step_and_the_fast_profile_have_rungs(smoke) -> None:
+    """The old "auto" (the contact rule) and the two ways back to its step without the spin
+    limit: the default's step is the spin-limited one, the three others take the contact step,
+    and the fast rung keeps the case's fixed time (its errors are the settings')."""
+    rungs = {r.name: r for r in ladder(smoke)}
+    steps = {n: choose_time_step(apply_rung(smoke, rungs[n]).dem_case()).time_step
+             for n in ("default", "contact", "no_tangential_damping", "fast")}
+    assert steps["default"] < 0.9 * steps["contact"]
+    assert steps["no_tangential_damping"] == pytest.approx(steps["contact"])
+    assert steps["fast"] == pytest.approx(steps["contact"])
+    fast = apply_rung(smoke, rungs["fast"])
+    assert not fast.contacts.tangential_damping and not fast.run.conduction
+    assert fast.run.stop == smoke.run.stop
+
+
 def test_reference_is_finest_and_conservative_is_the_issues(smoke) -> None:
     rungs = {r.name: r for r in ladder(smoke)}
     ref, cons = apply_rung(smoke, rungs[REFERENCE]), apply_rung(smoke, rungs[CONSERVATIVE])
