@@ -27,9 +27,15 @@ def test_skips_carry_measured_numbers_when_shipped() -> None:
     assert entry["measured"] is True
     assert entry["speedup"] > 1.0
     assert set(entry["errors_against_reference"]) == {"temperature", "h", "mass_flow"}
-    # The spin-limited 'auto' has no shipped rung yet: said, not borrowed from 'contact'.
+    # Each rule its own rung: 'auto' is the bench's default, 'contact' its contact rung (the
+    # shipped bench has both since 2026-11-25), so their speed-ups differ.
     auto = skips(tiny_drum(), "auto", False, "static_shell", 1)[1]
-    assert auto["skip"].startswith("time step 'auto'") and auto["measured"] is False
+    assert auto["skip"].startswith("time step 'auto'") and auto["measured"] is True
+    assert auto["rungs"] == ["default", "dt_10pct"] and entry["rungs"] == ["contact", "dt_10pct"]
+    assert entry["speedup"] > auto["speedup"]
+    dashpot = [e for e in skips(tiny_drum(contacts__tangential_damping=False), "auto", False,
+                                "static_shell", 1) if "tangential dashpot" in e["skip"]]
+    assert len(dashpot) == 1 and dashpot[0]["measured"] is True
 
 
 def test_nothing_listed_that_the_run_does_not_do() -> None:
