@@ -15,7 +15,7 @@ import math
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
-from drumflow.case import case_from_dict
+from drumflow.case import FAST_PROFILE, case_from_dict
 
 if TYPE_CHECKING:
     from drumflow.case import Case
@@ -93,7 +93,8 @@ def ladder(case: Case) -> list[Rung]:
                       {"contacts.tangential_damping": False}))
     rungs.append(Rung("fast", "profile", "the fast profile's settings (no tangential dashpot, no "
                       "conduction) at the fixed time",
-                      {"contacts.tangential_damping": False, "run.conduction": False}))
+                      {f"{section}.{name}": value for section, name, value in FAST_PROFILE
+                       if (section, name) != ("run", "stop")}))
     rungs.append(Rung("moving_mesh", "walls", "moving-mesh shell at the default time step",
                       {"run.wall_motion": "moving_mesh"}))
     for s in (0.5, 0.2):
