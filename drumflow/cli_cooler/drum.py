@@ -32,11 +32,18 @@ class DrumInputs(BaseModel):
     options: dict[str, Any]
 
 
-def _closures(source: Path) -> SliceClosures:
+def _closures(source: Path, start: float | None) -> SliceClosures:
     from drumflow.analysis.closures import extract_closures, load_closures
+    from drumflow.coolers.drum import DrumModelError
 
     if source.is_dir():
-        return extract_closures(source)
+        return extract_closures(source, start_s=start)
+    if start is not None:
+        # A closures file was measured over its own window (its `window_s`); silently ignoring
+        # the option would hand back closures the user did not ask for.
+        raise DrumModelError(f"--start = {start:g} s: allowed only with a slice run directory "
+                             f"as SOURCE; {source} is a closures file (measured over its "
+                             "own window_s)")
     return load_closures(source)
 
 
@@ -99,6 +106,13 @@ def drum(
         "--wall-loss", help="wall-loss coefficient U_w, W/(m2 K) over the shell (0 = off)")] = 0.0,
     lumped: Annotated[bool, typer.Option(
         "--lumped", help="lumped particles (Bi -> 0) instead of interior conduction")] = False,
+    closures_start: Annotated[float | None, typer.Option(
+        "--start", help="with a run directory: measure the closures from this simulated time "
+                        "on, s (default: the case's run.mass_flow_start); e.g. once the "
+                        "flights have filled")] = None,
+    save_closures: Annotated[Path | None, typer.Option(
+        "--save-closures", help="also write the slice closures to this JSON file (a SOURCE "
+                                "for later calls, no run directory needed)")] = None,
     out: Annotated[Path | None, typer.Option("--out", "-o", help="run directory")] = None,
     as_json: Annotated[bool, typer.Option("--json", help="print the result as JSON")] = False,
     force: Annotated[bool, typer.Option("--force", help="reuse a directory of another input")] = True,
@@ -124,10 +138,14 @@ def drum(
                             ("--length", length), ("--tilt", tilt)):
             if value is not None and not value > 0:
                 raise DrumModelError(f"{name} = {value}: allowed > 0")
+        if closures_start is not None and not closures_start >= 0:
+            raise DrumModelError(f"--start = {closures_start}: allowed >= 0 s (simulated time)")
         if particle_diameter is not None and particle_diameter > 0.05:
             raise DrumModelError(f"--particle-diameter = {particle_diameter}: allowed <= 0.05 m "
                                  "(give it in metres)")
-        closures = _closures(source)
+        closures = _closures(source, closures_start)
+        if save_closures is not None:
+            closures.write(save_closures)
         base = PAPER_PLANT
         # The transport law's one constant comes from the plant's measured residence time
         # (30 min), never from its outlet temperatures.
@@ -219,4 +237,6 @@ def drum(
     info.add_row("bed surface", f"{s.bed_surface_m2_per_m:.2f} m²/m")
     info.add_row("energy residual", f"{result.energy_residual:.1e}")
     info.add_row("written", f"{rundir.root / 'result.json'}, {plot}")
+    if save_closures is not None:
+        info.add_row("closures written", str(save_closures))
     console.print(info)

@@ -53,3 +53,38 @@ def test_closures_of_a_real_run(tiny_run: Path, tmp_path: Path) -> None:
     assert c.slip_velocity_m_s > 0 and c.cascades_per_revolution > 0
     path = c.write(tmp_path / "closures.json")
     assert load_closures(path) == c
+
+
+@pytest.mark.timeout(300)
+def test_plant_closures_from_a_later_start(tiny_run: Path, tmp_path: Path) -> None:
+    """`drumflow cooler drum RUN --start S --save-closures F`: the closures of the run from S on
+    (a paper run's flights fill for seconds; the plant wants the cascading bed's), written to a
+    file that is itself a SOURCE."""
+    import subprocess
+    import sys
+
+    import pandas as pd
+
+    from drumflow.analysis.observables import falling_mass_flow
+    from drumflow.case import load_case
+
+    saved = tmp_path / "closures.json"
+    args = [sys.executable, "-m", "drumflow.cli", "cooler", "drum", str(tiny_run), "--start", "1.5",
+            "--save-closures", str(saved), "--out", str(tmp_path / "plant"), "--json"]
+    out = subprocess.run(args, capture_output=True, text=True, timeout=240, check=False)
+    assert out.returncode == 0, out.stdout + out.stderr
+    late = load_closures(saved)
+    case = load_case(tiny_run / "case.toml")
+    crossings = pd.read_csv(tiny_run / "post" / "crossings.csv")
+    expected = falling_mass_flow(crossings, case.particles.mass, start=1.5).mass_flow_kg_s
+    assert late.falling_mass_flow_kg_s_m == pytest.approx(expected / case.drum.length, rel=1e-12)
+    # Only the snapshots from 1.5 s (every 0.1 s to 2 s): fewer than the default window's.
+    assert late.window_s[0] >= 1.5 - 1e-6
+    assert 0 < late.snapshots < extract_closures(tiny_run).snapshots
+    # The saved file is a SOURCE: the same prediction without the run directory.
+    again = subprocess.run([*args[:5], str(saved), "--json", "--out", str(tmp_path / "again")],
+                           capture_output=True, text=True, timeout=240, check=False)
+    assert again.returncode == 0, again.stdout + again.stderr
+    first = json.loads(out.stdout)
+    second = json.loads(again.stdout)
+    assert second["material_outlet_temperature_C"] == first["material_outlet_temperature_C"]

@@ -99,6 +99,17 @@ CASES_BAD: list[tuple[str, Setup, list[str]]] = [
         lambda t: ["cooler", "drum", str(CLOSURES), "--rpm", "-5", "--out", str(t / "drum")],
         ["--rpm", "-5"],
     ),
+    (
+        "cooler_drum_negative_start",
+        lambda t: ["cooler", "drum", str(CLOSURES), "--start", "-1", "--out", str(t / "drum")],
+        ["--start", "-1", ">= 0"],
+    ),
+    (
+        # A closures file was measured over its own window: --start cannot re-measure it.
+        "cooler_drum_start_on_a_closures_file",
+        lambda t: ["cooler", "drum", str(CLOSURES), "--start", "3", "--out", str(t / "drum")],
+        ["--start", "run directory", "window_s"],
+    ),
 ]
 
 

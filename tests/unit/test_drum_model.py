@@ -101,3 +101,33 @@ def test_bad_input_names_the_field() -> None:
     with pytest.raises(DrumModelError, match="material_inlet_temperature_c"):
         solve_drum(hot_air, CLOSURES, SMALL_LAW, DrumOptions(cells=5))
     assert math.isfinite(TransportLaw().residence_time_s(PAPER_PLANT))
+
+
+def test_the_plants_own_slice_needs_no_scaling() -> None:
+    """docs/plant/paper_model_one_closures.json: the closures of paper model one, a 0.1 m slice of
+    the plant itself (README, 'The plant's own slice'). Its drum is the plant's, and its hold-up
+    per metre, set from the paper's particle count, is the one the plant's measured residence
+    time gives (feed x 30 min / 19 m): two independent routes to one number. So the drum model
+    must carry the falling flow, falls per revolution and fall height over unchanged."""
+    from pathlib import Path
+
+    from drumflow.analysis.closures import load_closures
+
+    shipped = Path(__file__).resolve().parents[2] / "docs" / "plant" / "paper_model_one_closures.json"
+    closures = load_closures(shipped)
+    assert closures.case_name == "paper_model_one"
+    assert (closures.drum_diameter_m, closures.rpm, closures.tilt_deg) == (
+        PAPER_PLANT.diameter_m, PAPER_PLANT.rpm, PAPER_PLANT.tilt_deg)
+    assert PAPER_PLANT.residence_time_s is not None
+    plant_holdup = PAPER_PLANT.feed_rate_kg_s * PAPER_PLANT.residence_time_s / PAPER_PLANT.length_m
+    assert closures.holdup_kg_per_m == pytest.approx(plant_holdup, rel=1e-5)
+    # Measured over the cascading bed, after the flights' first filling (about 3.5 s).
+    assert closures.window_s[0] > 3.0
+    r = solve_drum(PAPER_PLANT, closures, LAW, DrumOptions(cells=40))
+    s = r.scaled
+    assert s.falling_mass_flow_kg_s_m == pytest.approx(closures.falling_mass_flow_kg_s_m, rel=1e-5)
+    assert s.cascades_per_revolution == pytest.approx(closures.cascades_per_revolution, rel=1e-12)
+    assert s.fall_height_m == pytest.approx(closures.fall_height_m, rel=1e-12)
+    assert abs(r.energy_residual) < 1e-9
+    inlet_air, inlet_solids = PAPER_PLANT.air_inlet_temperature_c, PAPER_PLANT.material_inlet_temperature_c
+    assert inlet_air < r.material_outlet_c < inlet_solids

@@ -1,6 +1,7 @@
-"""scripts/replicate_error.py on the shipped model-one run: a copy of it is its own replicate
-(every difference 0), a copy with its temperatures shifted shows the shift, and a run of
-another case is refused."""
+"""scripts/replicate_error.py on model one's first full-particle run (to 3.515 s, shipped in
+results/paper/model_one_replicate/first_run): a copy of it is its own replicate (every
+difference 0), a copy with its temperatures shifted shows the shift, and a run of another case
+is refused."""
 
 from __future__ import annotations
 
@@ -14,7 +15,7 @@ import pytest
 from support.scripts import load_script
 
 ROOT = Path(__file__).resolve().parents[2]
-SHIPPED = ROOT / "results" / "paper" / "model_one"
+SHIPPED = ROOT / "results" / "paper" / "model_one_replicate" / "first_run"
 PARCELS = ROOT / "results" / "paper_parcels" / "model_one"
 
 
