@@ -60,6 +60,7 @@ from __future__ import annotations
 
 import json
 import math
+import os
 from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -806,6 +807,12 @@ def plot_answer(replay: AnswerReplay, path: Path, title: str = "") -> None:
     plt.close(fig)
 
 
+def path_from(folder: Path, path: Path | str) -> str:
+    """``path`` as written in a results file kept in ``folder``: relative to it, so a shipped
+    file names its run the same in every checkout."""
+    return os.path.relpath(Path(path).resolve(), Path(folder).resolve())
+
+
 def write_answer(replay: AnswerReplay, folder: Path, title: str = "") -> dict[str, Path]:
     """Write ``answer.csv`` (per end time), ``answer.json`` and ``answer.png`` into ``folder``
     (created if missing); return their paths by name."""
@@ -813,6 +820,8 @@ def write_answer(replay: AnswerReplay, folder: Path, title: str = "") -> dict[st
     paths = {"table": folder / "answer.csv", "summary": folder / "answer.json",
              "plot": folder / "answer.png"}
     replay.table.to_csv(paths["table"], index=False, float_format="%.10g")
-    paths["summary"].write_text(json.dumps(replay.to_dict(), indent=2, allow_nan=False) + "\n")
+    summary = replay.to_dict()
+    summary["run_dir"] = path_from(folder, replay.run_dir)
+    paths["summary"].write_text(json.dumps(summary, indent=2, allow_nan=False) + "\n")
     plot_answer(replay, paths["plot"], title)
     return paths

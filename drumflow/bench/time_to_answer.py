@@ -50,6 +50,7 @@ from drumflow._json import json_safe
 from drumflow.bench.answer import (
     DEFAULT_TOLERANCE,
     AnswerReplay,
+    path_from,
     regular_end_times,
     replay_answer,
     settled_time,
@@ -401,6 +402,9 @@ def write_ladder(ladder: AnswerLadder, folder: Path) -> dict[str, Path]:
     folder.mkdir(parents=True, exist_ok=True)
     paths = {name.split(".")[1]: folder / name for name in LADDER_FILES}
     ladder.table.to_csv(paths["csv"], index=False, float_format="%.6g")
-    paths["json"].write_text(json.dumps(json_safe(ladder.to_dict()), indent=2) + "\n")
+    summary = ladder.to_dict()
+    for rung in summary["spec"]["rungs"]:
+        rung["run"] = path_from(folder, rung["run"])
+    paths["json"].write_text(json.dumps(json_safe(summary), indent=2) + "\n")
     plot_ladder(ladder, paths["png"])
     return paths

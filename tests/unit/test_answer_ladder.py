@@ -125,6 +125,11 @@ def test_writes_three_files_and_the_cli_prints_the_table(folder: Path, tmp_path:
     data = json.loads((tmp_path / "ladder.json").read_text())
     assert data["reference"] == "reference" and len(data["rungs"]) == 5
     assert data["rungs"][4]["stop_time_s"] is None  # NaN written as null
+    # Runs are named relative to the results folder, so a shipped ladder.json reads the same in
+    # every checkout (they were absolute paths of the machine that wrote them).
+    for rung in data["spec"]["rungs"]:
+        assert not Path(rung["run"]).is_absolute()
+        assert (tmp_path / rung["run"]).resolve() in {(folder / "a").resolve(), (folder / "b").resolve()}
 
 
 @pytest.mark.parametrize(("extra", "reference", "named"), [

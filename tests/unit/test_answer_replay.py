@@ -333,6 +333,7 @@ def test_cli_writes_the_three_files(tmp_path: Path) -> None:
     assert list(table["time_s"]) == pytest.approx([1.5, 2.0, 2.5, 3.0])
     assert summary["reference"]["time_s"] == pytest.approx(3.0)
     assert set(summary["settled_s"]) >= {"temperature", "mass_flow", "h"}
+    assert summary["run_dir"] == "../run"  # relative to the folder it is written in
 
 
 # ------------------------------------------------------------------------ shipped model two
