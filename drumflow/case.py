@@ -33,10 +33,21 @@ PositiveInt = Annotated[int, Field(ge=1)]
 Fraction = Annotated[float, Field(ge=0, le=1)]
 
 
+#: The settings of every input model (drum case, cooler cases, sweep file): one place, so
+#: that no case kind is looser than another.
+#:
+#: * ``extra="forbid"``: a typo such as ``diamter`` must not silently fall back to a default
+#:   and produce a different drum than the user meant.
+#: * ``strict=True``: a number written as text (``rpm = "5"``) is refused, not converted: TOML
+#:   has numbers, so quotes are a mistake (a value pasted from elsewhere, a wrong key) that
+#:   the user should see. An integer for a float field (``rpm = 5``) stays accepted.
+#: * ``allow_inf_nan=False``: ``inf`` and ``nan`` are valid TOML floats, but no field means
+#:   them, and a range check does not catch ``nan`` (every comparison is false).
+INPUT_MODEL_CONFIG = ConfigDict(extra="forbid", frozen=True, strict=True, allow_inf_nan=False)
+
+
 class _Section(BaseModel):
-    # Unknown keys are errors: a typo such as ``diamter`` must not silently fall back to a
-    # default and produce a different drum than the user meant.
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    model_config = INPUT_MODEL_CONFIG
 
 
 class Drum(_Section):
@@ -119,6 +130,19 @@ class Particles(_Section):
         "and heat act on each parcel as on the particles it stands for (same per kilogram); "
         "1 = every particle (default). See drumflow.case.Case.dem_case.",
     )
+    interior: Literal["lumped", "shells"] = Field(
+        "lumped",
+        description="heat inside the granule: 'lumped', one temperature per particle (the "
+        "paper's Eq. 20, valid for Biot numbers well below 0.1); 'shells', each particle's "
+        "radial temperature profile in concentric shells, the air's film acting on the surface "
+        "(drumflow.coupling.interior; needs air). The paper's cases stay 'lumped'.",
+    )
+    interior_shells: int | None = Field(
+        None, ge=2, le=40,
+        description="shells per particle with interior = 'shells'; default: the fewest whose "
+        "temperature drop is within 0.125 % of the exact sphere at the case's largest Biot "
+        "number (drumflow.coolers.particle_interior.shells_for_biot)",
+    )
 
     @model_validator(mode="after")
     def _count_or_fill(self) -> Particles:
@@ -199,6 +223,12 @@ class Air(_Section):
     pressure_gradient_force: bool = Field(
         False, description="add the pressure-gradient force of Eq. 4 to the drag"
     )
+    warming: bool = Field(
+        False, description="air that warms (two-way heat): the coupling loop solves the air's "
+        "temperature on the air field's grid with the particles' heat as its source, and each "
+        "particle sees the air of its cell (drumflow.air.heat); false: the paper's one-way air "
+        "at the inlet temperature everywhere",
+    )
 
 
 class Run(_Section):
@@ -271,6 +301,13 @@ class Run(_Section):
         "particles near the plane at every output step (text, about 3 GB for the paper's model "
         "one); 'loop': the air coupling loop finds them in memory and writes only the crossings "
         "(dem/coupling/crossings.csv; needs air)"
+    )
+    start_state: str | None = Field(
+        None, min_length=1, description="start the DEM from this start state (.npz, written by "
+        "`drumflow export RUN_DIR --state`) instead of the lattice placement: its particles, "
+        "velocities, spins, radii and temperatures at its simulated time and drum angle; a path "
+        "relative to the case file; its scene (drum, lifters, particles) and particle count must "
+        "be this case's"
     )
 
 
@@ -391,6 +428,17 @@ class Case(_Section):
                 "run.stop = 'converged': needs air (the stop rule watches the air's heat-transfer "
                 "coefficient); allowed with air.model = 'uniform' or 'cfd', else run.stop = 'fixed'"
             )
+        if self.air.warming and self.air.model == "none":
+            problems.append(
+                "air.warming = true: needs air (the coupling loop solves its temperature); "
+                "allowed with air.model = 'uniform' or 'cfd'"
+            )
+        if self.particles.interior == "shells" and self.air.model == "none":
+            problems.append(
+                "particles.interior = 'shells': needs air (the coupling loop advances the shells "
+                "with the air's film); allowed with air.model = 'uniform' or 'cfd', else "
+                "particles.interior = 'lumped'"
+            )
         if self.run.crossings == "loop" and self.air.model == "none":
             problems.append(
                 "run.crossings = 'loop': needs air (the coupling loop finds them); allowed with "
@@ -485,6 +533,11 @@ class Case(_Section):
         if "stop" not in data["run"]:
             for name in ("stop_tolerance", "stop_min_time"):
                 del data["run"][name]
+        state = data["run"].get("start_state")
+        if state is not None and Path(state).is_file():
+            # The state by its content, not its path: the path is resolved against the case
+            # file, so it names the checkout's place, and a moved checkout must keep its runs.
+            data["run"]["start_state"] = "sha256:" + hashlib.sha256(Path(state).read_bytes()).hexdigest()
         return json.dumps(data, sort_keys=True, separators=(",", ":"))
 
     def hash(self) -> str:
@@ -507,6 +560,10 @@ _ADDED_LATER: tuple[tuple[str, str, object], ...] = (
     ("run", "crossings", "dump"),
     ("particles", "coarse_grain", 1.0),
     ("contacts", "tangential_damping", True),
+    ("particles", "interior", "lumped"),
+    ("particles", "interior_shells", None),
+    ("air", "warming", False),
+    ("run", "start_state", None),
 )
 
 
@@ -522,10 +579,19 @@ def _format_error(err: dict[str, Any], loc: str) -> list[str]:
         return [f"{loc}: missing (required)"]
     if etype == "extra_forbidden":
         return [f"{loc} = {value!r}: unknown field (check the spelling)"]
+    if etype in _TYPES and isinstance(value, str):
+        # Strict input models (INPUT_MODEL_CONFIG): say what to write instead of the text.
+        return [f"{loc} = {value!r}: text, not {_TYPES[etype]}; write the value without quotes"]
+    if etype == "finite_number":
+        return [f"{loc} = {value!r}: not a finite number; allowed: a finite number (not inf or nan)"]
     ctx = err.get("ctx") or {}
     bounds = [f"{word} {ctx[key]}" for key, word in _BOUNDS if key in ctx]
     allowed = f"; allowed: {' and '.join(bounds)}" if bounds else ""
     return [f"{loc} = {value!r}: {msg[:1].lower()}{msg[1:]}{allowed}"]
+
+
+#: pydantic's type errors of the strict models and the type each one expects.
+_TYPES = {"float_type": "a number", "int_type": "an integer", "bool_type": "true or false"}
 
 
 _BOUNDS = (("gt", ">"), ("ge", ">="), ("lt", "<"), ("le", "<="))
@@ -587,11 +653,19 @@ def read_toml(path: Path | str) -> dict[str, Any]:
     CaseError
         When the file is missing or is not valid TOML.
     """
+    from drumflow.errors import BadFileError
+    from drumflow.readers import read_text
+
     path = Path(path)
     if not path.is_file():
         raise CaseError([f"case file {path}: not found"], path)
     try:
-        return tomllib.loads(path.read_text(encoding="utf-8"))
+        text = read_text(path, "a TOML file")
+    except BadFileError as exc:
+        # A CaseError like every other problem of an input file; the message names the file.
+        raise CaseError([exc.problem], path) from None
+    try:
+        return tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise CaseError([f"not valid TOML: {exc}"], path) from None
 
@@ -615,7 +689,15 @@ def load_case(path: Path | str) -> Case:
     CaseError
         When the file is missing, is not valid TOML, or has invalid values.
     """
-    return case_from_dict(read_toml(path), source=path)
+    data = read_toml(path)
+    run = data.get("run")
+    if isinstance(run, dict) and isinstance(run.get("start_state"), str):
+        # Relative to the case file, as written; the case holds it resolved, so that the copy
+        # of the case in a run directory still names the same file.
+        state = Path(run["start_state"]).expanduser()
+        if not state.is_absolute():
+            run["start_state"] = str((Path(path).resolve().parent / state).resolve())
+    return case_from_dict(data, source=path)
 
 
 #: The fast profile (``drumflow run --fast``; README, 'The fast profile'): each setting with the

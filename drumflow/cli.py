@@ -18,6 +18,7 @@ from typing import Annotated, Any
 
 import typer
 from rich import box
+from rich.markup import escape
 from rich.table import Table
 
 from drumflow.cli_cooler import app as cooler_app
@@ -99,6 +100,15 @@ def check(
                    " (contacts.tangential_damping = false: the tangential spring's own)")
         table.add_row("spin limit", f"{choice.spin_time_step_limit:.3g} s for the bed's contacts{dashpot}; "
                       f"{verdict}")
+    if case.air.model != "none":
+        from drumflow.coupling.spec import interior_spec, largest_biot
+
+        biot = largest_biot(case)
+        shells = interior_spec(case)
+        table.add_row("heat in the granule",
+                      f"{shells.shells} shells per particle (Bi up to {biot:.2g})" if shells is not None
+                      else f"lumped (Bi up to {biot:.2g}; one temperature per particle needs Bi well "
+                      "below 0.1, else particles.interior = 'shells')")
     console.print(table)
 
 
@@ -411,10 +421,17 @@ def report(
     as_json: Annotated[bool, typer.Option("--json", help="print the report path as JSON")] = False,
 ) -> None:
     """One self-contained HTML page: case, Tables 6-8, Figures 4, 6-9, manifest."""
+    from drumflow.readers import output_file
     from drumflow.report.html import write_report
 
+    output_file(out)  # before any analysis: a folder there would fail only at the end
+
+    def note(text: str) -> None:
+        # On stderr: the page holds them too, but "report written" alone would hide them.
+        err_console.print(f"[yellow]note:[/] {escape(text)}", highlight=False)
+
     path = write_report(run_dirs, out, nusselt_conductivity=conductivity,  # type: ignore[arg-type]
-                        render_3d=render_3d)
+                        render_3d=render_3d, on_note=note)
     if as_json:
         console.print_json(json.dumps({"report": str(path), "runs": [str(p) for p in run_dirs]}))
         return
@@ -465,8 +482,10 @@ def verify(
     ] = Path("runs/verify"),
 ) -> None:
     """Run the verification cases (analytic solutions, conservation laws) on the real solvers."""
+    from drumflow.readers import output_folder
     from drumflow.verify import run_verification
 
+    output_folder(out)
     table = Table(title="drumflow verify" + (" --quick" if quick else ""))
     for col in ("check", "measured", "expected", "error", "tolerance", ""):
         table.add_column(col, justify="right" if col not in ("check", "") else "left")
@@ -522,6 +541,10 @@ def bench(
     With --from RUN_DIR: LIGGGHTS' settings (neighbour skin, rebuild rule, sorting, processor
     grid, the conservative reference) side by side from one restart of that run -> settings.csv.
     """
+    from drumflow.readers import output_folder
+
+    if out is not None:
+        output_folder(out)
     case = _load(case_file)
     if from_run is not None:
         if time_s is not None or speed_only:
@@ -649,8 +672,11 @@ def profile(
 ) -> None:
     """Where the time goes: LIGGGHTS' timing breakdowns and the coupling loop's wall times."""
     from drumflow.bench.profile import profile_run, write_profile
+    from drumflow.readers import output_folder
     from drumflow.rundir import RunDir
 
+    if out is not None:
+        output_folder(out)  # checked first: the profile of a long run takes a while
     result = profile_run(run_dir, window_s=window)
     folder = out or RunDir.existing(run_dir).post
     paths = write_profile(result, folder, title=f"{run_dir.name}: where the time goes")
@@ -705,8 +731,11 @@ def answer(
 ) -> None:
     """Time to answer: what a run stopped earlier would report, and when the stop rule fires."""
     from drumflow.bench.answer import QUANTITIES, replay_answer, write_answer
+    from drumflow.readers import output_folder
     from drumflow.rundir import RunDir
 
+    if out is not None:
+        output_folder(out)  # checked first: the replay of a long run takes a while
     replay = replay_answer(run_dir, tolerance=tolerance, settle_tolerance=tolerance,
                            check_interval_s=every, particle_steps_per_s=rate)
     folder = out or RunDir.existing(run_dir).post
@@ -780,7 +809,10 @@ def ladder(
         load_ladder_spec,
         write_ladder,
     )
+    from drumflow.readers import output_folder
 
+    if out is not None:
+        output_folder(out)
     result = answer_ladder(load_ladder_spec(spec))
     paths = write_ladder(result, out or spec.parent)
     if as_json:

@@ -10,8 +10,11 @@ traceback.
 from __future__ import annotations
 
 import functools
+import inspect
+import math
 import os
 import sys
+import typing
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from typing import Any
@@ -34,7 +37,9 @@ def cli_console(stderr: bool = False) -> Console:
     :data:`LOG_WIDTH` columns in a file or pipe."""
     stream = sys.stderr if stderr else sys.stdout
     wide = not os.environ.get("COLUMNS") and not (hasattr(stream, "isatty") and stream.isatty())
-    return Console(stderr=stderr, width=LOG_WIDTH if wide else None)
+    # emoji=False: rich turns ":name:" into an emoji, so a path, a value or an error message
+    # holding such text (a time like 12:30:00, a file "a:smile:b") would print altered.
+    return Console(stderr=stderr, width=LOG_WIDTH if wide else None, emoji=False)
 
 
 _err_console = cli_console(stderr=True)
@@ -59,13 +64,59 @@ def guard(console: Console | None = None) -> Iterator[None]:
         raise typer.Exit(exit_code(exc)) from None
 
 
+def option_names(callback: Callable[..., Any]) -> dict[str, str]:
+    """The command-line name of each parameter of a typer command (``closures_start`` ->
+    ``--start``), from its ``typer.Option`` declarations; parameters without one keep their
+    Python name, with dashes."""
+    try:
+        hints = typing.get_type_hints(callback, include_extras=True)
+    except Exception:  # a name only imported for type checking: fall back to the plain names
+        hints = {}
+    names: dict[str, str] = {}
+    for name in inspect.signature(callback).parameters:
+        names[name] = "--" + name.rstrip("_").replace("_", "-")
+        for meta in getattr(hints.get(name), "__metadata__", ()):
+            # In an Annotated typer.Option("--start", ...) the name arrives as its "default".
+            given = [*(getattr(meta, "param_decls", None) or ()), getattr(meta, "default", None)]
+            decls = [d for d in given if isinstance(d, str) and d.startswith("--")]
+            if decls:
+                names[name] = decls[0]
+            elif type(meta).__name__ == "ArgumentInfo":
+                names[name] = name.upper()
+    return names
+
+
+def refuse_non_finite(values: dict[str, Any], names: dict[str, str]) -> None:
+    """Refuse ``inf`` and ``nan`` in every number option of a command, before it runs.
+
+    click reads "inf" and "nan" as floats, and a ``min=`` check lets ``nan`` pass where an
+    option has none; no option of drumflow means them, so they are bad input here, once for
+    every command, rather than a wrong message deep in a model ("allowed below nan rpm").
+
+    Raises
+    ------
+    AnalysisInputError
+        Naming the option (as typed on the command line), its value and what is allowed.
+    """
+    from drumflow.errors import AnalysisInputError
+
+    for key, value in values.items():
+        items = value if isinstance(value, list | tuple) else [value]
+        for item in items:
+            if isinstance(item, float) and not math.isfinite(item):
+                raise AnalysisInputError(names.get(key, key), item, "a finite number (not inf or nan)")
+
+
 def _guarded(callback: Callable[..., Any]) -> Callable[..., Any]:
     if getattr(callback, "__drumflow_guarded__", False):
         return callback
 
+    names = option_names(callback)
+
     @functools.wraps(callback)  # typer reads the wrapped signature (options, arguments)
     def wrapper(*args: Any, **kwargs: Any) -> Any:
         with guard():
+            refuse_non_finite(kwargs, names)
             return callback(*args, **kwargs)
 
     wrapper.__drumflow_guarded__ = True  # type: ignore[attr-defined]

@@ -97,8 +97,6 @@ def _print(runs: list[Any], paths: dict[str, Path]) -> None:
         sim, target = run.record.get("simulated_time_s"), run.record.get("target_time_s")
         if sim is not None:
             console.print(f"simulated {sim:.4g} of {target} s", highlight=False)
-        for note in run.notes:
-            err_console.print(f"[yellow]note:[/] {note}", highlight=False)
     console.print(f"written: {paths['json']}, {paths['csv']}, {paths['html']}", highlight=False)
 
 
@@ -117,6 +115,7 @@ def paper(
     as_json: Annotated[bool, typer.Option("--json", help="print the comparison as JSON")] = False,
 ) -> None:
     """The paper's two cases: run them (or read them) and compare with Tables 3-8, Figures 4, 6-9."""
+    from drumflow.readers import output_folder
     from drumflow.report.paper import (
         MODEL_DIRS,
         collect_paper_run,
@@ -125,6 +124,7 @@ def paper(
         write_paper,
     )
 
+    output_folder(out)  # before any run: a file there would fail only after hours
     if model not in _MODELS:
         raise typer.BadParameter(f"{model!r}; allowed: 'one', 'two' or 'both'", param_hint="--model")
     models = _MODELS[model]
@@ -160,6 +160,10 @@ def paper(
         runs.append(collect_paper_run(path, m, render_3d=render_3d))
     source = f"--from {root}" if from_ is not None else f"runs in {root}"
     paths = write_paper(runs, out, html, source=source)
+    # On stderr, with --json too: the page and paper.json hold them, "written" alone would not.
+    for run in runs:
+        for note in run.notes:
+            err_console.print(f"[yellow]note:[/] model {run.model}: {escape(note)}", highlight=False)
     if as_json:
         from drumflow._json import json_safe
 

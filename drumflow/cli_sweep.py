@@ -19,7 +19,7 @@ from rich.markup import escape
 from rich.table import Table
 
 from drumflow.cli_guard import cli_console
-from drumflow.errors import DrumflowError, exit_code
+from drumflow.errors import EXIT_BAD_INPUT, DrumflowError, exit_code
 
 console = cli_console()
 err_console = cli_console(stderr=True)
@@ -90,12 +90,15 @@ def sweep(
         "--json", help="print the final states (or the analysis) as JSON")] = False,
 ) -> None:
     """Run many cases over operating conditions (rpm, air flow, fill, ...) here or on SLURM."""
+    from drumflow.readers import output_folder
     from drumflow.sweep.driver import failure_report, open_sweep, run_sweep
     from drumflow.sweep.spec import SweepError
 
     try:
         if executor not in (None, "local", "slurm"):
             raise SweepError([f"--executor = {executor!r}: allowed: 'local' or 'slurm'"])
+        if out is not None:
+            output_folder(out)
         sd = open_sweep(target, out)
     except DrumflowError as exc:
         _fail(exc)
@@ -111,6 +114,7 @@ def sweep(
     try:
         ex = _executor(sd, executor, max_parallel)
     except DrumflowError as exc:
+        _forget_refused(sd, exc)
         _fail(exc)
         return
     # A SIGTERM (a batch system, `kill`) stops the session like Ctrl-C: members resumable.
@@ -124,6 +128,7 @@ def sweep(
             )
             live.update(_table(sd.sweep.name, outcome.statuses, ex.kind))
     except DrumflowError as exc:
+        _forget_refused(sd, exc)
         _fail(exc)
         return
     if as_json:
@@ -147,6 +152,16 @@ def sweep(
         return
     err_console.print(f"all {len(sd.members)} members done; next: drumflow sweep {sd.root} --analyse",
                       highlight=False)
+
+
+def _forget_refused(sd: Any, exc: BaseException) -> None:
+    """A refused session (bad input: the executor cannot run these members here) leaves
+    nothing behind: the sweep directory it made is removed, if no member was started in it.
+    A directory the user already had is never touched."""
+    import shutil
+
+    if sd.created and exit_code(exc) == EXIT_BAD_INPUT and not sd.ledger.attempts:
+        shutil.rmtree(sd.root, ignore_errors=True)
 
 
 def _static_rows(sd: Any) -> list[Any]:

@@ -236,6 +236,62 @@ class RunDirectoryError(DrumflowError, ValueError):
     """A run directory is missing what a stage needs, or belongs to a different case."""
 
 
+class BadFileError(RunDirectoryError):
+    """A file drumflow reads is unusable: not UTF-8 text, cut short, empty, not the format it
+    should be, or holding a NaN or a word where a number belongs (:mod:`drumflow.readers`).
+
+    A :class:`RunDirectoryError` (so a ``ValueError``: exit code 2) because most such files are
+    a run directory's, and the readers that skip a dump still being written catch that class;
+    it is raised for input files named on the command line as well.
+
+    Parameters
+    ----------
+    path
+        The file.
+    problem
+        What is wrong with it and where (line, row, column or field).
+    what
+        What the file holds, for the message (e.g. ``"the run's manifest"``).
+
+    Attributes
+    ----------
+    path, problem
+        As given.
+    """
+
+    def __init__(self, path: Path | str, problem: str, what: str = "") -> None:
+        self.path = Path(path)
+        self.problem = problem
+        held = f" ({what})" if what else ""
+        super().__init__(f"{path}{held}: {problem}")
+
+
+class StartStateError(DrumflowError, ValueError):
+    """A start state (``run.start_state``, :mod:`drumflow.dem.state`) that does not fit the case:
+    another scene (drum, lifters or particles), another particle count, or a file that is not a
+    drumflow start state. Bad input: exit code 2.
+
+    Parameters
+    ----------
+    path
+        The state file.
+    problem
+        What does not fit, with both values.
+
+    Attributes
+    ----------
+    field, path, problem
+        The case field (``run.start_state``) and the arguments.
+    """
+
+    field = "run.start_state"
+
+    def __init__(self, path: Path | str, problem: str) -> None:
+        self.path = Path(path)
+        self.problem = problem
+        super().__init__(f"{self.field} = {str(path)!r}: {problem}")
+
+
 class AnalysisInputError(DrumflowError, ValueError):
     """An argument of an analysis function is outside its allowed range.
 

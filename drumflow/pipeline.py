@@ -39,18 +39,20 @@ from drumflow.dem.stage import (
     ProgressCallback,
     clear_stop_request,
     kept_time_step,
+    load_start_state,
     plan_run,
 )
 from drumflow.dem.thermo import read_thermo
 from drumflow.dem.timestep import TimeStepChoice, choose_time_step
 from drumflow.errors import CaseError, RunDirectoryError
+from drumflow.readers import read_csv, read_json_object
 from drumflow.report.plots import (
     plot_air_heat,
     plot_crossings,
     plot_mean_temperature,
     plot_particles,
 )
-from drumflow.rundir import RunDir
+from drumflow.rundir import RunDir, write_json_atomic
 from drumflow.runner import LaunchProfile, Runner
 from drumflow.skips import skips
 
@@ -116,6 +118,14 @@ def run_case(
         data["run"]["processes"] = processes
         case = Case.model_validate(data)
     refuse_unavailable(case)
+    if not (Path(out) / "manifest.json").exists():
+        # A refused case leaves nothing behind: the time-step check (a fixed run.time_step above
+        # the stability limit) runs before the run directory is made. A directory with a run
+        # in it may keep the step it started with (kept_time_step), so it is checked there.
+        choose_time_step(case.dem_case())
+    # A start state that does not fit the case is refused before any stage runs (geometry and
+    # air take minutes at paper scale).
+    load_start_state(case)
     runner = Runner(profile)
     rundir = RunDir(out)
     rundir.bind_case(case.canonical_json(), case.hash(), case_to_toml(case), force=force,
@@ -157,7 +167,8 @@ def run_case(
     summary["wall_time_s"] = time.perf_counter() - t0
     summary["dem_wall_time_s"] = result.wall_time_s
     summary["particle_steps_per_s"] = result.particle_steps_per_s
-    rundir.summary_path.write_text(json.dumps(summary, indent=2))
+    # Whole or not at all: a sweep's monitor reads members' summaries while they run.
+    write_json_atomic(rundir.summary_path, summary)
     rundir.record("summary", summary)
     return summary
 
@@ -188,7 +199,7 @@ def _short_run_summary(case: Case, rundir: RunDir, result: DemResult, steps: int
         "wall_time_s": time.perf_counter() - t0,
         "dem": asdict(result),
     }
-    rundir.summary_path.write_text(json.dumps(summary, indent=2))
+    write_json_atomic(rundir.summary_path, summary)
     return summary
 
 
@@ -318,10 +329,12 @@ def post_run(out: Path | str, case: Case | None = None) -> dict[str, Any]:
         "post_read_s": read_s,
         "post_wall_time_s": time.perf_counter() - t0,
     }
-    old = json.loads(rundir.summary_path.read_text()) if rundir.summary_path.exists() else {}
+    # Checked, not guessed at: a damaged summary would lose what only the run knows.
+    old = (read_json_object(rundir.summary_path, "the run's summary")
+           if rundir.summary_path.exists() else {})
     # Keep what only the run knows (solver wall time, rates) when post is rerun alone.
     merged = {**old, **summary}
-    rundir.summary_path.write_text(json.dumps(merged, indent=2))
+    write_json_atomic(rundir.summary_path, merged)
     return merged
 
 
@@ -341,7 +354,8 @@ def _post_air(
     T_mean: np.ndarray,
 ) -> dict[str, Any]:
     """Heat the air took from the particles, its plot, and the energy balance check."""
-    coupling = read_coupling(rundir.dem_coupling_logs, time_step)
+    # Strict: a log cut short would give a wrong heat balance under status "ok".
+    coupling = read_coupling(rundir.dem_coupling_logs, time_step, covers_s=float(times[-1]))
     if coupling.empty:
         return {}
     coupling.to_csv(rundir.air_heat_csv, index=False, float_format="%.10g")
@@ -364,4 +378,35 @@ def _post_air(
         "particle_enthalpy_loss_J": loss,
         "energy_balance_error": closure,
         "mean_heat_removal_W": removed / float(times[-1]) if times[-1] > 0 else float("nan"),
+        **_air_warming_summary(rundir, float(times[-1]), removed, time_step),
     }
+
+
+def _air_warming_summary(rundir: RunDir, until_s: float, removed_J: float,
+                         time_step: float) -> dict[str, Any]:
+    """With ``air.warming``: what the air carried out (its outlet's enthalpy over the inlet's,
+    from the solved temperatures) against the heat the particles gave it, and its outlet
+    temperature over the last second. Empty for one-way air."""
+    logs = sorted(rundir.dem_coupling_logs.glob("air.*.csv"), key=lambda p: int(p.name.split(".")[1]))
+    if not logs:
+        return {}
+    # A resumed attempt supersedes what earlier attempts logged from its start on, as the
+    # coupling logs do.
+    parts = []
+    for i, log in enumerate(logs):
+        table = read_csv(log, "the air's temperature log (air.warming)")
+        if i + 1 < len(logs):
+            table = table[table["step"] < int(logs[i + 1].name.split(".")[1])]
+        parts.append(table)
+    air = pd.concat(parts, ignore_index=True)
+    air = air[air["time_s"] < until_s - 1e-12]
+    held = air["steps"].to_numpy(float) * time_step
+    gain = float(np.sum(air["air_enthalpy_gain_W"].to_numpy(float) * held))
+    last = air[air["time_s"] >= max(0.0, until_s - 1.0)]
+    return {
+        "air_enthalpy_gain_J": gain,
+        "air_energy_balance_error": abs(gain - removed_J) / abs(removed_J) if removed_J else float("nan"),
+        "air_outlet_temperature_C": float(last["outlet_C"].mean()),
+        "air_max_temperature_C": float(air["max_C"].max()),
+    }
+

@@ -28,7 +28,7 @@ import time
 from pathlib import Path
 from typing import Any
 
-from drumflow.errors import RunDirectoryError
+from drumflow.errors import BadFileError, RunDirectoryError
 
 
 def file_hash(path: Path) -> str:
@@ -64,6 +64,55 @@ def cpu_model() -> str:
     return platform.processor() or "unknown"
 
 
+def write_json_atomic(path: Path, data: Any) -> None:
+    """Write ``data`` as JSON through a temporary file renamed over ``path``.
+
+    A reader (``drumflow status``, a sweep's monitor polling its members) then sees the old
+    file or the new one, never half of one, and a writer killed part way leaves the old file:
+    a record that does not parse was damaged from outside (a copy cut, a disk filled), and the
+    readers refuse it rather than guess.
+    """
+    tmp = path.with_name(path.name + ".tmp")
+    tmp.write_text(json.dumps(data, indent=2))
+    tmp.replace(path)
+
+
+def read_stage_marker(path: Path) -> dict[str, Any]:
+    """A stage marker (``stages/<name>.json``), checked: a JSON object (its ``key`` and
+    ``result`` are checked where they are used, :meth:`RunDir.stage_done`).
+
+    A damaged marker is refused, not read as "stage not finished": the markers decide what a
+    rerun keeps, and a DEM stage taken as unfinished starts afresh when no restart matches,
+    deleting the run's dumps, restarts and coupling logs (``dem.stage._prepare_workdir``), so
+    guessing could destroy a finished run. Markers are written whole (:func:`write_json_atomic`),
+    so a damaged one never is a stage being finished right now.
+
+    Raises
+    ------
+    BadFileError
+        Not UTF-8, empty, cut short or not an object; the message says how to rerun the stage.
+    """
+    from drumflow.readers import read_json_object
+
+    what = _marker_what(path)
+    try:
+        return read_json_object(path, what)
+    except BadFileError as exc:
+        raise BadFileError(path, exc.problem + _marker_hint(path), what) from None
+
+
+def _marker_what(path: Path) -> str:
+    return f"the record that the {path.stem} stage finished"
+
+
+def _marker_hint(path: Path) -> str:
+    """How to get past a damaged marker: delete it, and what the rerun then does."""
+    stage = path.stem
+    return (f"; delete it to run the {stage} stage again (`drumflow run` with the same case "
+            "and --out" + (": the DEM resumes from its newest restart, or starts afresh "
+                           "without one)" if stage == "dem" else ")"))
+
+
 class RunDir:
     """A run directory with its manifest.
 
@@ -71,15 +120,25 @@ class RunDir:
     ----------
     root
         The directory (created if missing).
+
+    Raises
+    ------
+    BadFileError
+        ``root`` is an existing file, or its ``manifest.json`` is not a readable JSON object
+        (cut short, not UTF-8).
     """
 
     def __init__(self, root: Path | str, create: bool = True) -> None:
+        from drumflow.readers import output_folder, read_json_object
+
         self.root = Path(root).resolve()
         if create:
-            self.root.mkdir(parents=True, exist_ok=True)
+            # An existing file there would end in mkdir's FileExistsError and a traceback.
+            output_folder(self.root, "a run directory (--out)").mkdir(parents=True, exist_ok=True)
         self.manifest_path = self.root / "manifest.json"
         self.manifest: dict[str, Any] = (
-            json.loads(self.manifest_path.read_text()) if self.manifest_path.exists() else {}
+            read_json_object(self.manifest_path, "the run's manifest")
+            if self.manifest_path.exists() else {}
         )
 
     @classmethod
@@ -268,13 +327,44 @@ class RunDir:
         return self.stages / f"{stage}.json"
 
     def _finished(self, stage: str) -> dict[str, Any] | None:
+        return self.stage_record(stage)
+
+    def stage_record(self, stage: str) -> dict[str, Any] | None:
+        """The marker of a finished stage (its ``key``, ``result``, timing), or None when the
+        stage has not finished.
+
+        Raises
+        ------
+        BadFileError
+            The marker is damaged (:func:`read_stage_marker`).
+        """
         path = self._marker(stage)
-        return json.loads(path.read_text()) if path.exists() else None
+        return read_stage_marker(path) if path.exists() else None
+
+    def finished_stages(self) -> list[str]:
+        """The stages with a marker, each marker checked (:func:`read_stage_marker`)."""
+        markers = sorted(self.stages.glob("*.json"))
+        for marker in markers:
+            read_stage_marker(marker)  # refuses a damaged one (an empty object is a marker)
+        return [p.stem for p in markers]
 
     def stage_done(self, stage: str, key: str) -> dict[str, Any] | None:
-        """The stage's recorded result if it finished with the same input ``key``."""
+        """The stage's recorded result if it finished with the same input ``key``.
+
+        Raises
+        ------
+        BadFileError
+            The marker is damaged, or holds this key without a ``result`` object (the stage
+            would be skipped with nothing to return).
+        """
         data = self._finished(stage)
-        return data if data is not None and data.get("key") == key else None
+        if data is None or data.get("key") != key:
+            return None
+        if not isinstance(data.get("result"), dict):
+            path = self._marker(stage)
+            raise BadFileError(path, f"result = {data.get('result')!r}: expected the stage's "
+                               "result (an object)" + _marker_hint(path), _marker_what(path))
+        return data
 
     def finished_key(self, stage: str) -> str | None:
         """The input key the stage last finished with, or None if it has not finished."""
@@ -287,7 +377,7 @@ class RunDir:
         path.parent.mkdir(parents=True, exist_ok=True)
         data = {"key": key, "result": result, "wall_time_s": wall_time_s,
                 "finished": time.strftime("%Y-%m-%dT%H:%M:%S%z")}
-        path.write_text(json.dumps(data, indent=2))
+        write_json_atomic(path, data)
         self.manifest.setdefault("stages", {})[stage] = {
             "key": key,
             "wall_time_s": wall_time_s,

@@ -6,8 +6,8 @@ set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 bash "$here/scripts/install.sh"
 cd "$here"
-echo "== ruff check drumflow tests scripts"
-.venv/bin/ruff check drumflow tests scripts
+echo "== ruff check drumflow tests scripts studies"
+.venv/bin/ruff check drumflow tests scripts studies
 echo "== mypy drumflow"
 .venv/bin/mypy drumflow
 echo "== pytest"

@@ -88,16 +88,18 @@ def air_cache_key(case: Case) -> str:
     because the air field does not depend on them: the particles and contacts (one-way
     coupling: particles do not act on the air), the run settings, ``drum.facet_size`` and
     ``drum.tilt_deg`` (the DEM wall STL and gravity's direction; the air model has no gravity),
-    and of the air section ``coupling_interval``, ``pressure_gradient_force`` and
-    ``heat_capacity`` (they act only on the particle side). The resampling version
-    :data:`FIELD_FORMAT_VERSION` is part of the key.
+    and of the air section ``coupling_interval``, ``pressure_gradient_force``, ``heat_capacity``
+    and ``warming`` (they act only on the particle side, or on the air's temperature, not its
+    flow; a field option added later must be left out too, or every cached field and every run
+    keyed on one is recomputed). The resampling version :data:`FIELD_FORMAT_VERSION` is part of
+    the key.
     """
     data = case.model_dump(mode="json")
     drum = {k: v for k, v in data["drum"].items() if k not in ("facet_size", "tilt_deg")}
     air = {
         k: v
         for k, v in data["air"].items()
-        if k not in ("coupling_interval", "pressure_gradient_force", "heat_capacity")
+        if k not in ("coupling_interval", "pressure_gradient_force", "heat_capacity", "warming")
     }
     key = {
         "version": FIELD_FORMAT_VERSION,
@@ -543,25 +545,36 @@ class AirField:
 
         Raises
         ------
-        ValueError
-            When the file was written by another :data:`FIELD_FORMAT_VERSION`.
+        BadFileError
+            When the file is missing, cut short or not an air field (a missing array named),
+            or was written by another :data:`FIELD_FORMAT_VERSION`.
         """
-        with np.load(Path(path), allow_pickle=False) as z:
-            version = int(z["format_version"])
-            if version != FIELD_FORMAT_VERSION:
-                raise ValueError(
-                    f"{path}: air field format {version}, this drumflow reads "
-                    f"{FIELD_FORMAT_VERSION}; delete the file to recompute it"
-                )
-            return cls(
-                origin=z["origin"],
-                spacing=z["spacing"],
-                velocity=z["velocity"],
-                pressure=z["pressure"],
-                fluid=z["fluid"],
-                omega=float(z["omega"]),
-                meta=json.loads(str(z["meta"])),
-            )
+        from drumflow.errors import BadFileError
+        from drumflow.readers import read_npz
+
+        what = "the run's air field"
+        z = read_npz(path, what)
+        missing = [k for k in ("format_version", "origin", "spacing", "velocity", "pressure",
+                               "fluid", "omega", "meta") if k not in z]
+        if missing:
+            raise BadFileError(path, f"not an air field: no array(s) {', '.join(missing)}", what)
+        version = int(z["format_version"])
+        if version != FIELD_FORMAT_VERSION:
+            raise BadFileError(path, f"air field format {version}, this drumflow reads "
+                               f"{FIELD_FORMAT_VERSION}; delete the file to recompute it", what)
+        try:
+            meta = json.loads(str(z["meta"]))
+        except json.JSONDecodeError as exc:
+            raise BadFileError(path, f"its meta entry is not JSON ({exc.msg})", what) from None
+        return cls(
+            origin=z["origin"],
+            spacing=z["spacing"],
+            velocity=z["velocity"],
+            pressure=z["pressure"],
+            fluid=z["fluid"],
+            omega=float(z["omega"]),
+            meta=meta,
+        )
 
 
 def plot_air_cross_section(

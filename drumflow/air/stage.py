@@ -105,7 +105,8 @@ def run(case: Case, rundir: RunDir, runner: Runner, inputs: AirInputs) -> AirRes
         u_mean = mean_axial_velocity(case)
         rho = ideal_gas_density(case.air.inlet_temperature_C, case.air.pressure_kPa)
         summary = AirSummary("uniform", rho, u_mean, case.air.mass_flow, case.air.mass_flow)
-        result = AirResult(uniform_field(case), summary)
+        result = AirResult(_uniform_grid(case, rundir) if case.air.warming else uniform_field(case),
+                           summary)
     else:
         result = _run_cfd(case, rundir, runner, inputs)
     if inputs.progress:
@@ -113,6 +114,17 @@ def run(case: Case, rundir: RunDir, runner: Runner, inputs: AirInputs) -> AirRes
         # air.max_iterations).
         inputs.progress("air", 1.0, 1.0)
     return result
+
+
+def _uniform_grid(case: Case, rundir: RunDir) -> FieldSource:
+    """Plug flow on the air field's grid: air that warms is solved on a grid
+    (:mod:`drumflow.air.heat`), and the particles sample the same uniform velocity from it."""
+    from drumflow.air.field import AirField, air_cache_key
+
+    rundir.air.mkdir(parents=True, exist_ok=True)
+    AirField.uniform(case).to_npz(rundir.air_field)
+    return FieldSource({"kind": "grid", "path": str(rundir.air_field)},
+                       "uniform-grid:" + air_cache_key(case), 0.0)
 
 
 def _solve_into_cache(case: Case, rundir: RunDir, runner: Runner, inputs: AirInputs,

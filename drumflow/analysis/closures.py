@@ -37,12 +37,15 @@ from typing import Any
 import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
 
 from drumflow.analysis.air_side import airborne_mask
 from drumflow.analysis.observables import falling_mass_flow
 from drumflow.case import Case, load_case
 from drumflow.dem.dumps import dump_files, read_dump
-from drumflow.errors import RunDirectoryError
+from drumflow.errors import BadFileError, RunDirectoryError
+from drumflow.readers import read_csv, read_json_object
+from drumflow.rundir import RunDir
 
 __all__ = ["SliceClosures", "bed_surface_length", "extract_closures", "load_closures"]
 
@@ -151,23 +154,84 @@ class SliceClosures:
         return out
 
 
+# Finite numbers only: a NaN closure would pass every comparison of the drum model and end
+# in a root finder's error (or a wrong profile) far from the file that held it.
+_Positive = Field(gt=0, allow_inf_nan=False)
+_NonNegative = Field(ge=0, allow_inf_nan=False)
+
+
+class ClosuresFile(BaseModel):
+    """What a closures JSON file must hold, each field a finite number in its range (strict
+    types: a word, a boolean or ``NaN`` where a number belongs is refused by name).
+
+    Derived entries written by :meth:`SliceClosures.to_dict` (``froude``,
+    ``cascades_per_revolution``) are ignored: they are recomputed.
+    """
+
+    model_config = ConfigDict(strict=True, extra="ignore")
+
+    source: str
+    case_name: str
+    drum_diameter_m: float = _Positive
+    section_length_m: float = _Positive
+    rpm: float = _Positive
+    tilt_deg: float = Field(ge=0, lt=90, allow_inf_nan=False)
+    lifter_count: int = Field(ge=0)
+    particle_diameter_m: float = _Positive
+    particle_density_kg_m3: float = _Positive
+    holdup_kg_per_m: float = _Positive
+    solids_volume_fraction: float = Field(gt=0, lt=1, allow_inf_nan=False)
+    air_axial_velocity_m_s: float = _NonNegative
+    falling_mass_flow_kg_s_m: float = _Positive
+    airborne_fraction: float = Field(ge=0, le=1, allow_inf_nan=False)
+    fall_time_s: float = _NonNegative
+    fall_height_m: float = _NonNegative
+    airborne_speed_m_s: float = _NonNegative
+    airborne_downward_speed_m_s: float = _NonNegative
+    slip_velocity_m_s: float = _NonNegative
+    bed_slip_velocity_m_s: float = _NonNegative
+    bed_surface_m2_per_m: float = _NonNegative
+    snapshots: int = Field(ge=1)
+    window_s: list[float] = Field(min_length=2, max_length=2)
+
+    @field_validator("window_s")
+    @classmethod
+    def _ordered_window(cls, value: list[float]) -> list[float]:
+        if not all(math.isfinite(v) and v >= 0 for v in value) or value[0] > value[1]:
+            raise ValueError("allowed: [start, end], finite times >= 0 s with start <= end")
+        return value
+
+
+def _closure_problems(exc: ValidationError, data: dict[str, Any]) -> list[str]:
+    """One line per problem: the field, its value and what is allowed."""
+    lines = []
+    for err in exc.errors():
+        loc = err["loc"]
+        name = ".".join(str(part) for part in loc) or "(file)"
+        top = loc[0] if loc else None
+        value = data.get(top) if isinstance(top, str) else None
+        shown = "missing" if err["type"] == "missing" else f"= {value!r}"
+        lines.append(f"{name} {shown}: {err['msg']}")
+    return lines
+
+
 def load_closures(path: Path | str) -> SliceClosures:
-    """Read closures written by :meth:`SliceClosures.write`.
+    """Read closures written by :meth:`SliceClosures.write`, validated by :class:`ClosuresFile`.
 
     Raises
     ------
-    RunDirectoryError
-        When the file is missing, not JSON, or lacks a field.
+    BadFileError
+        When the file is missing, not UTF-8, not JSON (or cut short), or a field is missing, not
+        a finite number, or outside its range (each problem names the field and its value).
     """
     p = Path(path)
+    data = read_json_object(p, "a closures file")
     try:
-        data = json.loads(p.read_text())
-    except FileNotFoundError:
-        raise RunDirectoryError(f"{p}: no such closures file") from None
-    except json.JSONDecodeError as exc:
-        raise RunDirectoryError(f"{p}: not a closures JSON file ({exc.msg})") from None
-    if not isinstance(data, dict):
-        raise RunDirectoryError(f"{p}: not a closures JSON object")
+        ClosuresFile.model_validate(data)
+    except ValidationError as exc:
+        problems = _closure_problems(exc, data)
+        raise BadFileError(p, "invalid closures:\n" + "\n".join(f"  - {line}" for line in problems),
+                           "a closures file") from None
     return SliceClosures.from_dict(data)
 
 
@@ -242,26 +306,35 @@ def extract_closures(run_dir: Path | str, start_s: float | None = None) -> Slice
     RunDirectoryError
         When a file is missing or the run has no falling particles or no snapshot in the window.
     """
-    root = Path(run_dir).resolve()
-    case_file = root / "case.toml"
-    crossings_file = root / "post" / "crossings.csv"
+    run = RunDir.existing(run_dir)
+    root = run.root
+    case_file = run.case_toml
+    # The run's own table, or the gzipped copy shipped results hold (post/crossings.csv.gz).
+    crossings_file = run.crossings_table
     for f, what in ((case_file, "the case"), (crossings_file, "the crossing table")):
         if not f.exists():
             raise RunDirectoryError(f"{f}: missing ({what}); run `drumflow run CASE --out "
                                     f"{root}` (or `drumflow post {root}`) first")
+    snaps = [f for f in dump_files(run.dem_dumps, "snap")]
+    if not snaps:
+        # Checked before the crossing table is read (seconds for a paper run): shipped results
+        # keep no snapshots, and the airborne share, speeds and bed surface need them.
+        raise RunDirectoryError(
+            f"{run.dem_dumps}: no particle snapshot (snap.*.txt or .npz); the closures need the "
+            "run's snapshots (shipped results do not keep them): give the run directory itself, "
+            "or a closures JSON file saved from it with --save-closures")
     case = load_case(case_file)
     start = case.run.mass_flow_start if start_s is None else float(start_s)
     length = case.drum.length
     mass = case.particles.mass
-    crossings = pd.read_csv(crossings_file)
+    crossings = read_csv(crossings_file, "the crossing table", columns=("time", "id", "x", "z"),
+                         finite=("time", "x", "z"))
     flow = falling_mass_flow(crossings, mass, start=start)
     if flow.mass_flow_kg_s <= 0:
         raise RunDirectoryError(f"{crossings_file}: no particle fell after {start:g} s")
-    snaps = [f for f in dump_files(root / "dem" / "dumps", "snap")]
-    manifest = json.loads((root / "manifest.json").read_text()) if (root / "manifest.json").exists() else {}
-    time_step = manifest.get("time_step", {}).get("time_step")
+    time_step = run.manifest.get("time_step", {}).get("time_step")
     if time_step is None:
-        raise RunDirectoryError(f"{root}/manifest.json: no DEM time step recorded")
+        raise RunDirectoryError(f"{run.manifest_path}: no DEM time step recorded")
     sampler = _air_sampler(root, case)
     u_plug = _uniform_air_velocity(case)
     airborne_shares: list[float] = []
@@ -304,7 +377,7 @@ def extract_closures(run_dir: Path | str, start_s: float | None = None) -> Slice
     fall_time = phi * holdup / g_f
     down = float(np.mean(downs)) if downs else math.nan
     drum_volume = math.pi * case.drum.radius**2 * length
-    return SliceClosures(
+    closures = SliceClosures(
         source=str(root),
         case_name=case.name,
         drum_diameter_m=float(case.drum.diameter),
@@ -329,3 +402,14 @@ def extract_closures(run_dir: Path | str, start_s: float | None = None) -> Slice
         snapshots=len(times),
         window_s=(float(min(times[0], flow.window_start_s)), float(max(times[-1], flow.window_end_s))),
     )
+    # The same check as a closures file's: a NaN (no airborne particle in any snapshot) would
+    # otherwise stop the drum model far from its cause, or be saved with --save-closures.
+    data = closures.to_dict()
+    try:
+        ClosuresFile.model_validate(data)
+    except ValidationError as exc:
+        lines = "\n".join(f"  - {line}" for line in _closure_problems(exc, data))
+        raise RunDirectoryError(
+            f"{run.dem_dumps}: the closures of its {len(times)} snapshot(s) after {start:g} s are "
+            f"not usable (a NaN: no airborne particle in any of them?):\n{lines}") from None
+    return closures

@@ -71,6 +71,7 @@ from drumflow.errors import (
     NoHeatTransferError,
     RunDirectoryError,
 )
+from drumflow.readers import reaches_time
 from drumflow.rundir import RunDir
 
 __all__ = [
@@ -412,6 +413,9 @@ def analyse_run(
     RunDirectoryError
         If the CSV is malformed or the plant streams are inconsistent (the message names the
         file).
+    BadFileError
+        If the CSV ends before the simulated time ``summary.json`` records (cut short), or
+        ``summary.json`` is damaged.
     drumflow.errors.CaseError
         If ``case.toml`` is not a valid case.
     ValueError
@@ -426,6 +430,8 @@ def analyse_run(
     case = load_case(run.case_toml)
     _require_air(case, run.case_toml)
     series = _read_series(run.mean_temperature_csv)
+    # A series cut short reads as a shorter valid run: its averages would be wrong in silence.
+    reaches_time(run.mean_temperature_csv, float(series.t[-1]), run.summary_path)
     if until is not None:
         series = _series_until(series, until)
     window = _falling_window_of(series, case, run.mean_temperature_csv)

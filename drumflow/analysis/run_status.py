@@ -25,6 +25,8 @@ from drumflow.coupling.spec import STOPPED_RECORD
 from drumflow.dem.stage import restart_files
 from drumflow.dem.thermo import COLUMNS, ThermoParser, log_files
 from drumflow.errors import DrumflowError, MissingRunFileError
+from drumflow.readers import read_json_object
+from drumflow.rundir import read_stage_marker
 
 if TYPE_CHECKING:
     from drumflow.case import Case
@@ -188,6 +190,9 @@ def run_status(run_dir: Path | str, now: float | None = None) -> RunStatus:
     MissingRunFileError
         ``run_dir`` has no ``manifest.json``: not a run directory, or one whose run has not
         started.
+    BadFileError
+        Its ``manifest.json`` is not a readable JSON object (cut short, not UTF-8), or a
+        stage marker (``stages/*.json``) is damaged.
     """
     from drumflow.case import load_case
 
@@ -195,9 +200,15 @@ def run_status(run_dir: Path | str, now: float | None = None) -> RunStatus:
     manifest_path = root / "manifest.json"
     if not manifest_path.is_file():
         raise MissingRunFileError(manifest_path.resolve(), "the run's manifest")
-    manifest = json.loads(manifest_path.read_text())
+    # The manifest is replaced atomically (RunDir.save): one that does not parse was damaged.
+    manifest = read_json_object(manifest_path, "the run's manifest")
     case = load_case(root / "case.toml")
-    stages = {p.stem for p in (root / "stages").glob("*.json")}
+    # Each marker read, not only listed: a damaged one is refused naming it (read_stage_marker
+    # says why it is not taken as "stage not finished"), not reported as a finished run.
+    markers = sorted((root / "stages").glob("*.json"))
+    for marker in markers:
+        read_stage_marker(marker)
+    stages = {p.stem for p in markers}
     done = [s for s in STAGE_ORDER if s in stages] + sorted(stages - set(STAGE_ORDER))
     time_step = (manifest.get("time_step") or {}).get("time_step")
 

@@ -91,11 +91,13 @@ from drumflow.coupling.log import measured_rate, read_coupling, update_walls
 from drumflow.coupling.stop import StopMonitor, min_stop_time, rule_inputs
 from drumflow.errors import (
     AnalysisInputError,
+    BadFileError,
     MissingRunFileError,
     NoHeatTransferError,
     RunDirectoryError,
     RunTooShortError,
 )
+from drumflow.readers import read_csv, read_json_object
 from drumflow.rundir import RunDir
 
 __all__ = [
@@ -130,6 +132,10 @@ QUANTITIES = {"temperature": ("temperature_C", "(a) mean temperature at 3.5 s"),
 # digits, a few 1e-9 s off at 17.5 s; 1e-6 s tells them apart from their neighbours safely.
 _TIME_EPS_S = 1e-6
 _RUN_RECORD = "run_record.json"
+#: Columns of the run's tables that must hold a finite number in every row (the first row's
+#: falling mass is NaN by construction: no step ends there).
+_SERIES_FINITE = ("time_s", "mean_temperature_C")
+_AIR_HEAT_FINITE = ("step", "time_s", "steps", "heat_to_particles_W")
 
 
 @dataclass(frozen=True)
@@ -352,6 +358,9 @@ def replay_answer(
     RunDirectoryError
         Not a run directory, or a file is malformed; also the errors of
         :func:`~drumflow.analysis.methodology.analyse_run` on the whole run.
+    BadFileError
+        A table or ``run_record.json`` is damaged: not UTF-8, cut short, a missing column, or
+        a NaN or a word where a number belongs (file, row and column named).
     """
     for name, value in (("tolerance", tolerance), ("settle_tolerance", settle_tolerance)):
         if not (math.isfinite(value) and 0.0 < value < 1.0):
@@ -374,7 +383,9 @@ def replay_answer(
     # The whole run first: it validates the files and is the reference.
     full = analyse_run(run.root, falling_mass=falling_mass)
     case = full.case
-    temps = pd.read_csv(run.mean_temperature_csv)
+    temps = read_csv(run.mean_temperature_csv, "mean particle temperature per output step",
+                     columns=(*_SERIES_FINITE, "falling_mass_kg_in_step"), finite=_SERIES_FINITE,
+                     min_rows=2)
     out_t = temps["time_s"].to_numpy(float)
     end = float(out_t[-1])
     start = float(case.run.mass_flow_start)
@@ -384,9 +395,9 @@ def replay_answer(
     grid = _grid(out_t, start, check_interval_s, times)
 
     updates, dt = _updates(case, run, temps, end)
-    crossings = pd.read_csv(run.crossings_table)
-    if "time" not in crossings.columns:
-        raise RunDirectoryError(f"{run.crossings_table}: no column 'time' (rerun `drumflow post DIR`)")
+    # Checked: a cut .csv.gz ended in gzip's EOFError, which click turns into a bare "Aborted."
+    crossings = read_csv(run.crossings_table, "the particles crossing the axis plane",
+                         columns=("time",), finite=("time",))
     monitor = _monitor(case, run, updates, crossings, dt)
     wall, wall_info = _wall_per_update(run, updates, dt, particle_steps_per_s)
     notes: list[str] = []
@@ -481,7 +492,8 @@ def _updates(case: Case, run: RunDir, temps: pd.DataFrame,
              end: float) -> tuple[pd.DataFrame, float]:
     """The coupling updates up to the end of the temperature series, with the whole-surface h
     the stop rule uses (:func:`drumflow.analysis.paper.coupling_h`), and the DEM time step."""
-    air_heat = pd.read_csv(run.air_heat_csv)
+    air_heat = read_csv(run.air_heat_csv, "the heat the air took at each coupling update",
+                        columns=_AIR_HEAT_FINITE, finite=_AIR_HEAT_FINITE, min_rows=1)
     try:
         coupling = coupling_h(case, air_heat, temps)
     except AnalysisInputError as exc:
@@ -722,11 +734,18 @@ def _rate_from_record(run: RunDir, updates: pd.DataFrame) -> tuple[float | None,
     path = run.root / _RUN_RECORD
     if not path.is_file():
         return None, "none: no wall times logged and no run_record.json"
-    record = json.loads(path.read_text())
+    what = "the shipped run's timings"
+    record = read_json_object(path, what)
     wall = record.get("dem_wall_time_s")
     simulated = record.get("simulated_time_s")
     if not wall or not simulated:
         return None, f"none: {path.name} has no dem_wall_time_s"
+    for name, value in (("dem_wall_time_s", wall), ("simulated_time_s", simulated)):
+        # A NaN is truthy: it would give every estimated wall time as NaN, in silence.
+        if (not isinstance(value, int | float) or isinstance(value, bool)
+                or not math.isfinite(value) or value <= 0):
+            raise BadFileError(path, f"{name} = {value!r}: expected a positive number of "
+                               "seconds", what)
     t_upd = updates["time_s"].to_numpy(float)
     done = t_upd < float(simulated) - _TIME_EPS_S
     work = float(np.sum(updates["particles"].to_numpy(float)[done]

@@ -31,7 +31,6 @@ Other without it, and the shares of the wall time (``share_*``) count it with th
 
 from __future__ import annotations
 
-import json
 import math
 import re
 from dataclasses import dataclass
@@ -43,7 +42,8 @@ import pandas as pd
 
 from drumflow.coupling.log import WALL_COLUMNS, read_coupling
 from drumflow.dem.thermo import LOOP_TIME
-from drumflow.errors import RunDirectoryError
+from drumflow.errors import BadFileError, RunDirectoryError
+from drumflow.readers import read_json_object
 from drumflow.rundir import RunDir
 
 __all__ = [
@@ -234,15 +234,26 @@ def _clock(rundir: RunDir) -> tuple[float | None, tuple[int, float]]:
     """The DEM step and the (step, time) the run's clock counts from: (0, 0) but for a
     settings-study variant with another step, whose coupling input names its restart's."""
     spec_path = rundir.dem / "coupling.json"
-    spec = json.loads(spec_path.read_text()) if spec_path.is_file() else {}
-    step, time = spec.get("clock_origin", [0, 0.0])
-    origin = (int(step), float(time))
+    what = "the coupling loop's input"
+    spec = read_json_object(spec_path, what) if spec_path.is_file() else {}
+    try:
+        step, time = spec.get("clock_origin", [0, 0.0])
+        origin = (int(step), float(time))
+        spec_step = float(spec["time_step"]) if "time_step" in spec else None
+    except (TypeError, ValueError):
+        # A word, a list of another length, or null: int() and float() said so without the file.
+        raise BadFileError(spec_path, f"clock_origin = {spec.get('clock_origin')!r}, time_step = "
+                           f"{spec.get('time_step')!r}: expected [step, time in s] and a time "
+                           "step in s", what) from None
+    if not math.isfinite(origin[1]) or (spec_step is not None
+                                        and not (math.isfinite(spec_step) and spec_step > 0)):
+        raise BadFileError(spec_path, f"clock_origin = {spec.get('clock_origin')!r}, time_step = "
+                           f"{spec.get('time_step')!r}: expected finite numbers, a positive step",
+                           what)
     value = (rundir.manifest.get("time_step") or {}).get("time_step")
     if value:
         return float(value), origin
-    if "time_step" in spec:
-        return float(spec["time_step"]), origin
-    return None, origin
+    return spec_step, origin
 
 
 def _runs(rundir: RunDir) -> pd.DataFrame:

@@ -56,6 +56,7 @@ from drumflow.bench.answer import (
     settled_time,
 )
 from drumflow.errors import CaseError
+from drumflow.readers import read_text
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -150,13 +151,18 @@ def load_ladder_spec(path: Path) -> LadderSpec:
     Raises
     ------
     CaseError
-        Unreadable file, an invalid field (named, with its value and what is allowed), or a run
-        folder that does not exist.
+        Missing or not TOML, an invalid field (named, with its value and what is allowed), or
+        a run folder that does not exist.
+    BadFileError
+        Not UTF-8 text, or a folder.
     """
-    if not path.is_file():
+    if not path.exists():
         raise CaseError([f"ladder spec {path}: not found"], path)
+    # read_text names a folder given for the file and a spec not saved as UTF-8 (the byte and
+    # its line); Path.read_text ended in a traceback.
+    text = read_text(path, "a ladder spec")
     try:
-        data = tomllib.loads(path.read_text())
+        data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as err:
         raise CaseError([f"ladder spec {path}: not valid TOML: {err}"], path) from None
     try:

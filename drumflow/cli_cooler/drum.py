@@ -133,19 +133,24 @@ def drum(
     )
 
     with guard():
-        for name, value in (("--cells", cells), ("--rpm", rpm), ("--air-flow", air_flow),
-                            ("--feed-rate", feed_rate), ("--particle-diameter", particle_diameter),
-                            ("--length", length), ("--tilt", tilt)):
-            if value is not None and not value > 0:
-                raise DrumModelError(f"{name} = {value}: allowed > 0")
+        for name, value, most in (("--cells", cells, 5000), ("--rpm", rpm, 60.0),
+                                  ("--air-flow", air_flow, 1000.0), ("--feed-rate", feed_rate, 1000.0),
+                                  ("--particle-diameter", particle_diameter, None),
+                                  ("--length", length, 200.0), ("--tilt", tilt, 30.0)):
+            # Upper bounds as the drum case's own (drum.rpm, air.mass_flow, plant.length,
+            # drum.tilt_deg; DrumOptions' cells): beyond them the model fails somewhere else and
+            # blames another quantity (--length 1e300 was reported as "cells = 40").
+            if value is not None and not (value > 0 and (most is None or value <= most)):
+                upper = "" if most is None else f" and <= {most:g}"
+                raise DrumModelError(f"{name} = {value:g}: allowed > 0{upper}")
+        if not 0 <= wall_loss <= 1000:
+            raise DrumModelError(f"--wall-loss = {wall_loss:g}: allowed >= 0 and <= 1000 W/(m2 K)")
         if closures_start is not None and not closures_start >= 0:
             raise DrumModelError(f"--start = {closures_start}: allowed >= 0 s (simulated time)")
         if particle_diameter is not None and particle_diameter > 0.05:
             raise DrumModelError(f"--particle-diameter = {particle_diameter}: allowed <= 0.05 m "
                                  "(give it in metres)")
         closures = _closures(source, closures_start)
-        if save_closures is not None:
-            closures.write(save_closures)
         base = PAPER_PLANT
         # The transport law's one constant comes from the plant's measured residence time
         # (30 min), never from its outlet temperatures.
@@ -159,6 +164,9 @@ def drum(
         start = time.perf_counter()
         result = solve_drum(plant, closures, law, options)
         wall = time.perf_counter() - start
+        if save_closures is not None:
+            # After the model accepted the inputs: a refused command writes nothing.
+            closures.write(save_closures)
         warnings = extrapolation_warnings(plant, base, closures, result.scaled) + result.warnings
         ua, textbook = volumetric_coefficient_estimate(plant)
         exchanger = paper_exchanger(plant)

@@ -49,12 +49,22 @@ def fluid_bed(
         case = load_fluid_bed_case(case_file)
         suffix = f"-month{month:02d}" if month is not None else ("-year" if year else "")
         run_out = out or Path("runs/cooler/fluid-bed") / f"{case.name}{suffix}"
-        rundir = open_cooler_run(run_out, "fluid-bed", case, case_file.read_text(), force)
-        root = rundir.root
         start = time.perf_counter()
         target = case.refrigeration.target_product_temperature_K
+        # The model runs (seconds) before the run directory is made: a case it refuses
+        # leaves nothing behind.
         if year:
             months = operate_year(case)
+        elif month is not None:
+            weather = {m.month: m for m in load_weather(case.weather.table)}[month]
+            op = operate(case, month_conditions(case, weather))
+            label = f"{weather.name}: "
+        else:
+            op = operate(case, case_conditions(case))
+            label = ""
+        rundir = open_cooler_run(run_out, "fluid-bed", case, case_file.read_text(), force)
+        root = rundir.root
+        if year:
             rows = [{"month": m.month, "name": m.name, **_flat(op.summary())} for m, op in months]
             plots.write_rows_csv(rows, root / "year.csv")
             plots.plot_year(months, root / "year.png", target)
@@ -64,13 +74,6 @@ def fluid_bed(
             write_result(rundir, result, time.perf_counter() - start)
             _print_year(rows, root, as_json)
             return
-        if month is not None:
-            weather = {m.month: m for m in load_weather(case.weather.table)}[month]
-            op = operate(case, month_conditions(case, weather))
-            label = f"{weather.name}: "
-        else:
-            op = operate(case, case_conditions(case))
-            label = ""
         _unit_outputs(plots, op, root, target, label)
         summary = {**_flat(op.summary()), **_sections(op)}
         write_result(rundir, {"model": "fluid-bed", "case": case.name, "month": month, **summary},
@@ -99,10 +102,11 @@ def fit(
         case = load_fluid_bed_case(case_file)
         points = read_points(data)
         run_out = out or Path("runs/cooler/fluid-bed") / f"{case.name}-fit"
+        start = time.perf_counter()
+        # Fitted before the run directory is made: a refused fit leaves nothing behind.
+        result = fit_parameters(case, points)
         rundir = open_cooler_run(run_out, "fluid-bed-fit", case, case_file.read_text(), force)
         rundir.record("data", {"file": str(data.resolve()), "points": len(points)})
-        start = time.perf_counter()
-        result = fit_parameters(case, points)
         root = rundir.root
         plots.plot_fit(result, root / "fit.png")
         rows = [{"measured_product_K": mp, "model_product_K": p, "measured_air_K": ma, "model_air_K": a}

@@ -33,11 +33,15 @@ def grate(
     from drumflow.coolers.grate import plots
     from drumflow.coolers.grate.case import load_grate_case
     from drumflow.coolers.grate.model import solve_grate
-    from drumflow.coolers.grate.studies import parse_vary, run_sweep
+    from drumflow.coolers.grate.studies import parse_vary, run_sweep, vary_cases
 
     with guard():
         case = load_grate_case(case_file)
         sweep_spec = parse_vary(vary) if vary else None
+        if sweep_spec is not None:
+            # Every varied case checked before the run directory is made: a refused study
+            # leaves nothing behind.
+            vary_cases(case, *sweep_spec)
         start = time.perf_counter()
         if sweep_spec is None:
             run_out = out or Path("runs/cooler/grate") / case.name

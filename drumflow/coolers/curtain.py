@@ -43,9 +43,10 @@ from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import NDArray
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import BaseModel, Field, model_validator
 
 from drumflow import air_properties
+from drumflow.case import INPUT_MODEL_CONFIG
 from drumflow.coolers._propagator import exposure_matrix
 from drumflow.coolers.particle_interior import Sphere, SphereConduction
 from drumflow.coupling.physics import AirState, ranz_marshall_h
@@ -74,8 +75,17 @@ PAPER_GAS_TABLE: dict[str, tuple[float, float]] = {
 }
 
 
+#: Most elements (rows x columns, automatic rows included) a curtain may have. Measured here
+#: (2 shared cores): 8.4 s for 1000 x 1000 elements at 20 shells and 35 s at the most shells
+#: (400), so the largest allowed curtain finishes in well under a minute; the old maxima
+#: (100,000 rows x 1,000 columns, automatic rows unbounded) meant hours. The paper's
+#: curtains have about 100 x 10.
+MAX_ELEMENTS = 1_000_000
+
+
 class _Section(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    # The one input-model config (strict types, finite numbers): drumflow.case.
+    model_config = INPUT_MODEL_CONFIG
 
 
 class CurtainSolids(_Section):
@@ -153,7 +163,25 @@ class CurtainCase(_Section):
                 "numerics.rows = 'auto': needs gas.velocity > 0 (Eq. 2 divides by the gas "
                 "contact time); give an integer number of rows for a still gas"
             )
+        rows = self.rows()
+        if rows * n.columns > MAX_ELEMENTS:
+            which = (f"numerics.rows = 'auto' ({rows:,} rows by Eq. 2 from geometry.height, "
+                     "gas.velocity, solids.fall_velocity and geometry.thickness)"
+                     if n.rows == "auto" else f"numerics.rows = {rows:,}")
+            raise ValueError(
+                f"{which} x numerics.columns = {n.columns:,}: {rows * n.columns:,} elements; "
+                f"allowed up to {MAX_ELEMENTS:,} (fewer rows or columns)"
+            )
         return self
+
+    def rows(self) -> int:
+        """The number of rows M: ``numerics.rows``, or Eq. 2's for 'auto'."""
+        if self.numerics.rows != "auto":
+            return self.numerics.rows
+        contact = self.geometry.thickness / (self.gas.velocity * self.numerics.columns)  # Eq. 1
+        # Capped before rounding: a huge M is refused by its size, not by an overflow.
+        return max(1, round(min(self.geometry.height / (self.solids.fall_velocity * contact),
+                                1e15)))  # Eq. 2
 
 
 @dataclass(frozen=True)
@@ -353,11 +381,7 @@ def solve_curtain(case: CurtainCase, *, h_w_m2k: float | None = None) -> Curtain
     h = float(ranz_marshall_h(g.velocity, s.diameter, gas.air_state())) if h_w_m2k is None \
         else float(h_w_m2k)
     columns = num.columns
-    if num.rows == "auto":
-        contact = geo.thickness / (g.velocity * columns)  # Eq. 1
-        rows = max(1, round(geo.height / (s.fall_velocity * contact)))  # Eq. 2
-    else:
-        rows = num.rows
+    rows = case.rows()
     dz = geo.height / rows
     exposure_time = dz / s.fall_velocity
     voidage = 1.0 - s.mass_flow / (s.density * s.fall_velocity * geo.width * geo.thickness)

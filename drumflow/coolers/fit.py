@@ -35,7 +35,8 @@ from drumflow.coolers.fluid_bed import (
     operate,
     run_unit,
 )
-from drumflow.errors import CaseError
+from drumflow.errors import BadFileError, CaseError
+from drumflow.readers import read_text
 
 FloatArray = NDArray[np.float64]
 
@@ -62,12 +63,17 @@ def read_points(path: Path | str) -> list[OperatingPoint]:
     Raises
     ------
     CaseError
-        Missing file or columns, or a value outside its range (the row and column named).
+        Missing file or columns, not UTF-8 text, or a value that is not a number or outside its
+        range (the row and column named).
     """
     path = Path(path)
     if not path.is_file():
         raise CaseError([f"data file {path}: not found"], path)
-    lines = [ln for ln in path.read_text().splitlines() if ln.strip() and not ln.startswith("#")]
+    try:
+        text = read_text(path, "operating points")
+    except BadFileError as exc:
+        raise CaseError([exc.problem], path) from None
+    lines = [ln for ln in text.splitlines() if ln.strip() and not ln.startswith("#")]
     reader = csv.DictReader(lines)
     missing = [c for c in COLUMNS if c not in (reader.fieldnames or [])]
     if missing:

@@ -36,10 +36,10 @@ from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import NDArray
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import BaseModel, Field, model_validator
 from scipy.optimize import brentq
 
-from drumflow.case import read_toml, validate_model
+from drumflow.case import INPUT_MODEL_CONFIG, read_toml, validate_model
 from drumflow.coolers import _fluidization as fl
 from drumflow.coolers.particle_interior import Sphere, SphereConduction
 from drumflow.coolers.refrigeration import (
@@ -56,7 +56,8 @@ KELVIN = 273.15
 
 # == the case ===================================================================================
 class _Section(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    # The one input-model config (strict types, finite numbers): drumflow.case.
+    model_config = INPUT_MODEL_CONFIG
 
 
 class SizeDistribution(_Section):
@@ -258,25 +259,68 @@ class MonthWeather:
     rh_mean_pct: float
 
 
+#: Allowed values of a weather table's numbers (°C, %): a month outside them is a typing error
+#: (and a NaN one would stop CoolProp's humid-air functions with an error of their own).
+WEATHER_LIMITS = {"t_mean_C": (-60.0, 60.0), "t_max_mean_C": (-60.0, 70.0), "rh_mean_pct": (0.0, 100.0)}
+
+
 def load_weather(table: str | Path = "salamanca") -> list[MonthWeather]:
     """The monthly weather table: the shipped AEMET normals or a CSV of the same columns
-    (month, name, t_mean_C, t_max_mean_C, rh_mean_pct; '#' lines are comments)."""
+    (month, name, t_mean_C, t_max_mean_C, rh_mean_pct; '#' lines are comments).
+
+    Raises
+    ------
+    CaseError
+        The file is missing or not UTF-8, a column is missing, or a value is not a finite
+        number within :data:`WEATHER_LIMITS` (each problem names the file, row and column).
+    """
+    from drumflow.errors import BadFileError
+    from drumflow.readers import read_text
+
     if str(table) == "salamanca":
         text = (resources.files("drumflow.coolers") / "data" / "salamanca_aemet_1981_2010.csv").read_text()
     else:
         path = Path(table)
         if not path.is_file():
             raise CaseError([f"weather.table = {table}: file not found"])
-        text = path.read_text()
+        try:
+            text = read_text(path, "a weather table")
+        except BadFileError as exc:
+            raise CaseError([f"weather.table = {table}: {exc.problem}"]) from None
     rows = [line for line in text.splitlines() if line.strip() and not line.startswith("#")]
+    reader = csv.DictReader(rows)
+    columns = ("month", "name", *WEATHER_LIMITS)
+    missing = [c for c in columns if c not in (reader.fieldnames or [])]
+    if missing:
+        raise CaseError([f"weather.table = {table}: no column(s) {', '.join(missing)}; columns: "
+                         "month, name, t_mean_C, t_max_mean_C, rh_mean_pct"])
     out = []
-    try:
-        for row in csv.DictReader(rows):
-            out.append(MonthWeather(int(row["month"]), row["name"], float(row["t_mean_C"]),
-                                    float(row["t_max_mean_C"]), float(row["rh_mean_pct"])))
-    except (KeyError, ValueError) as exc:
-        raise CaseError([f"weather.table = {table}: bad row ({exc}); columns: month, name, "
-                         "t_mean_C, t_max_mean_C, rh_mean_pct"]) from None
+    problems = []
+    for i, row in enumerate(reader, start=1):
+        where = f"weather.table = {table}, data row {i}"
+        try:
+            month = int(row["month"] or "")
+        except ValueError:
+            problems.append(f"{where}, month = {row['month']!r}: allowed a whole number 1 to 12")
+            continue
+        values: dict[str, float] = {}
+        for col, (lo, hi) in WEATHER_LIMITS.items():
+            text_value = (row[col] or "").strip()
+            try:
+                v = float(text_value)
+            except ValueError:
+                problems.append(f"{where}, {col} = {text_value!r}: not a number")
+                continue
+            if not (math.isfinite(v) and lo <= v <= hi):
+                problems.append(f"{where}, {col} = {text_value}: allowed a finite number >= {lo:g} "
+                                f"and <= {hi:g}")
+                continue
+            values[col] = v
+        if len(values) == len(WEATHER_LIMITS):
+            out.append(MonthWeather(month, row["name"] or "", values["t_mean_C"],
+                                    values["t_max_mean_C"], values["rh_mean_pct"]))
+    if problems:
+        raise CaseError(problems)
     if sorted(m.month for m in out) != list(range(1, 13)):
         raise CaseError([f"weather.table = {table}: needs months 1 to 12 once each"])
     return sorted(out, key=lambda m: m.month)

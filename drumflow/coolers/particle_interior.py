@@ -278,3 +278,190 @@ def lumped_mean_temperature(sphere: Sphere, h: float, initial: float, gas: float
     rate = h * sphere.surface / (sphere.mass * sphere.heat_capacity)
     t = np.atleast_1d(np.asarray(time, dtype=float))
     return np.asarray(gas + (initial - gas) * np.exp(-rate * t), dtype=float)
+
+
+# -- many particles at once: the coupling loop's interior -------------------------------------
+#: Relative error of the shell model's temperature drop, against the series solution, that
+#: :func:`shells_for_biot` aims at: a quarter of the 0.5 % the coupled check allows, so the
+#: loop's other errors (the interval's hold of h, round-off) keep their room.
+SHELL_TOLERANCE = 1.25e-3
+#: Fewest and most shells the rule may choose (memory: 8 bytes a shell a particle).
+MIN_SHELLS, MAX_SHELLS = 3, 40
+
+
+def shell_drop_error(biot: float, shells: int) -> float:
+    """Relative error of the mean-temperature drop of a ``shells``-shell sphere at ``biot``.
+
+    Measured where the series solution has removed 63.2 % of the initial excess (one lumped
+    time constant's worth), on a unit sphere with unit diffusivity: the error of equal-thickness
+    shells depends only on Bi and the shell count at a given fraction of the drop.
+    """
+    if not (math.isfinite(biot) and biot > 0):
+        raise ValueError(f"biot = {biot!r}: must be a finite number > 0")
+    unit = Sphere(diameter=2.0, conductivity=1.0, density=1.0, heat_capacity=1.0)
+    h = biot  # Bi = h R / k with R = k = 1
+    # Time of 63.2 % of the drop, from the series' mean excess (monotone in time).
+    target = math.exp(-1.0)
+
+    def excess(fo: float) -> float:
+        return float(series_mean_temperature(unit, h, 1.0, 0.0, fo)[0]) - target
+
+    hi = 1.0
+    while excess(hi) > 0:
+        hi *= 2.0
+    t = float(brentq(excess, 1e-9, hi, xtol=1e-12))
+    model = SphereConduction(unit, shells)
+    final, _ = model.advance(model.uniform(1.0), h, 0.0, t, max_step=min(t / 200.0, model.default_step))
+    return abs((1.0 - model.mean_temperature(final)) / (1.0 - target) - 1.0)
+
+
+def shells_for_biot(biot: float, tolerance: float = SHELL_TOLERANCE) -> int:
+    """Fewest shells whose drop is within ``tolerance`` of the series solution at ``biot``.
+
+    The error of equal-thickness shells falls as 1/shells^2 and grows with Bi (measured: 5 shells
+    err by 0.08 % at Bi 0.1, 0.6 % at Bi 1 and 1.4 % at Bi 3), so the count comes from the
+    largest Biot number a case expects. At most :data:`MAX_SHELLS`.
+    """
+    for shells in range(MIN_SHELLS, MAX_SHELLS + 1):
+        if shell_drop_error(biot, shells) <= tolerance:
+            return shells
+    return MAX_SHELLS
+
+
+class ShellBatch:
+    """The shell model of :class:`SphereConduction` for many particles at once.
+
+    Each row is one particle: ``shells`` equal-thickness shells, innermost first, in the same
+    finite-volume, Crank-Nicolson scheme (so a row is what :class:`SphereConduction` computes,
+    to round-off, and the heat given to the gas equals the enthalpy drop of the row). Rows
+    differ in radius, heat capacity, film coefficient and gas temperature; the solve is the
+    Thomas algorithm vectorised over rows, a loop of ``shells`` numpy operations.
+
+    Parameters
+    ----------
+    shells
+        Shells per particle (>= 2).
+    conductivity
+        Thermal conductivity of the particles, W/(m K).
+    diffusivity
+        Thermal diffusivity k / (rho cp), m^2/s (sets the sub-step, :meth:`advance`).
+    """
+
+    def __init__(self, shells: int, conductivity: float, diffusivity: float) -> None:
+        if shells < 2:
+            raise ValueError(f"shells = {shells}: must be >= 2")
+        for name, value in (("conductivity", conductivity), ("diffusivity", diffusivity)):
+            if not (math.isfinite(value) and value > 0):
+                raise ValueError(f"{name} = {value!r}: must be a finite number > 0")
+        self.shells = shells
+        self.conductivity = conductivity
+        self.diffusivity = diffusivity
+        faces = np.arange(shells + 1) / shells
+        #: Each shell's share of the particle's volume (and heat capacity).
+        self.fractions: FloatArray = faces[1:] ** 3 - faces[:-1] ** 3
+        # Conductance between shells i and i+1 of a particle of radius R is k 4 pi R M r_i^2,
+        # r_i the unit radius of their common face: this is the factor without k R.
+        self._inner = 4.0 * math.pi * shells * faces[1:-1] ** 2
+
+    def mean(self, temperatures: FloatArray) -> FloatArray:
+        """Caloric mean temperature of each row."""
+        return np.asarray(temperatures @ self.fractions, dtype=float)
+
+    def surface_conductance(self, h: FloatArray, radius: FloatArray) -> FloatArray:
+        """Conductance from the outer shell's centre through the film to the gas, W/K."""
+        area = 4.0 * math.pi * radius**2
+        half_shell = 0.5 * radius / self.shells / (self.conductivity * area)
+        with np.errstate(divide="ignore"):
+            return np.where(h > 0.0, 1.0 / (1.0 / (h * area) + half_shell), 0.0)
+
+    def surface_temperature(self, temperatures: FloatArray, h: FloatArray, radius: FloatArray,
+                            gas_temperature: FloatArray | float) -> FloatArray:
+        """Temperature of each row's surface, between its outer shell and the film."""
+        g = self.surface_conductance(h, radius)
+        area = 4.0 * math.pi * radius**2
+        outer = temperatures[:, -1]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            film_drop = np.where(h > 0.0, g * (outer - gas_temperature) / (h * area), 0.0)
+        return np.where(h > 0.0, gas_temperature + film_drop, outer)
+
+    def add_surface_heat(self, temperatures: FloatArray, mean_rise: FloatArray) -> None:
+        """Put heat that entered through the surface (contact conduction) into the outer shell,
+        in place: ``mean_rise`` is the rise of each row's mean temperature it amounts to."""
+        temperatures[:, -1] += mean_rise / self.fractions[-1]
+
+    def step(self, temperatures: FloatArray, h: FloatArray, gas_temperature: FloatArray | float,
+             radius: FloatArray, capacity: FloatArray, dt: float) -> tuple[FloatArray, FloatArray]:
+        """One Crank-Nicolson step of every row; returns (temperatures, heat to the gas, J).
+
+        ``capacity`` is each particle's m cp, J/K; ``h`` its film coefficient, W/(m^2 K).
+        """
+        new, heat = self._step_columns(np.ascontiguousarray(temperatures.T), h, gas_temperature,
+                                       radius, capacity, dt)
+        return np.ascontiguousarray(new.T), heat
+
+    def _step_columns(self, t0: FloatArray, h: FloatArray, gas_temperature: FloatArray | float,
+                      radius: FloatArray, capacity: FloatArray,
+                      dt: float) -> tuple[FloatArray, FloatArray]:
+        # Shell-major layout (m, n): every operation of the Thomas sweep runs over one
+        # contiguous row of particles (4 times faster than column slices at 467,443 x 12).
+        m, n = t0.shape
+        c = self.fractions[:, None] * capacity[None, :]  # shell capacities, J/K
+        gk = self._inner[:, None] * (self.conductivity * radius)[None, :]  # (m-1, n), W/K
+        gs = self.surface_conductance(h, radius)
+        tg = np.broadcast_to(np.asarray(gas_temperature, float), (n,))
+        # (C - dt/2 K) T1 = (C + dt/2 K) T0 + dt gs Tg e_m, K the conduction operator.
+        half = 0.5 * dt
+        diff = gk * (t0[1:] - t0[:-1])  # flow from shell i+1 into shell i, W
+        rhs = c * t0
+        rhs[:-1] += half * diff
+        rhs[1:] -= half * diff
+        rhs[-1] += dt * gs * tg - half * gs * t0[-1]
+        diag = c
+        diag[:-1] += half * gk
+        diag[1:] += half * gk
+        diag[-1] += half * gs
+        off = -half * gk  # the symmetric off-diagonal
+        # Thomas algorithm (the matrix is diagonally dominant: no pivoting needed).
+        cprime = np.empty((m - 1, n))
+        dprime = np.empty((m, n))
+        cprime[0] = off[0] / diag[0]
+        dprime[0] = rhs[0] / diag[0]
+        for i in range(1, m):
+            denom = diag[i] - off[i - 1] * cprime[i - 1]
+            if i < m - 1:
+                cprime[i] = off[i] / denom
+            dprime[i] = (rhs[i] - off[i - 1] * dprime[i - 1]) / denom
+        new = dprime
+        for i in range(m - 2, -1, -1):
+            new[i] -= cprime[i] * new[i + 1]
+        heat = half * gs * ((t0[-1] - tg) + (new[-1] - tg))
+        return new, heat
+
+    def sub_steps(self, duration: float, radius: FloatArray) -> int:
+        """Equal Crank-Nicolson steps for ``duration``: none longer than a quarter of the
+        thinnest shell's diffusion time, as :attr:`SphereConduction.default_step`."""
+        if len(radius) == 0:
+            return 1
+        limit = 0.25 * (float(np.min(radius)) / self.shells) ** 2 / self.diffusivity
+        return max(1, math.ceil(duration / limit - 1e-12))
+
+    def advance(self, temperatures: FloatArray, h: FloatArray, gas_temperature: FloatArray | float,
+                radius: FloatArray, capacity: FloatArray,
+                duration: float) -> tuple[FloatArray, FloatArray]:
+        """Advance every row ``duration`` seconds at constant h and gas temperature.
+
+        Returns
+        -------
+        (temperatures, heat)
+            The new shell temperatures and the heat each particle gave the gas, J.
+        """
+        if not duration > 0:
+            raise ValueError(f"duration = {duration!r}: must be > 0")
+        steps = self.sub_steps(duration, radius)
+        dt = duration / steps
+        heat = np.zeros(len(temperatures))
+        current = np.ascontiguousarray(temperatures.T)
+        for _ in range(steps):
+            current, q = self._step_columns(current, h, gas_temperature, radius, capacity, dt)
+            heat += q
+        return np.ascontiguousarray(current.T), heat

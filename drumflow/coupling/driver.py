@@ -50,9 +50,17 @@ import numpy as np
 from numpy.typing import NDArray
 
 from drumflow.coupling.crossings import CrossingTracker
+from drumflow.coupling.interior import (
+    INTERIOR_LOG_PATTERN,
+    SHELL_FIX,
+    UNSET,
+    InteriorLoop,
+    InteriorSpec,
+    granule,
+)
 from drumflow.coupling.library import Liggghts
 from drumflow.coupling.mpi import allreduce_sum
-from drumflow.coupling.physics import AirState, convective_heat, drag_force
+from drumflow.coupling.physics import AirState, convective_heat, drag_force, ranz_marshall_h
 from drumflow.coupling.spec import OVERLAP_OFF, OVERLAP_ON, STOP_REQUEST, STOPPED_RECORD
 from drumflow.coupling.stop import StopMonitor
 
@@ -170,6 +178,72 @@ def air_load(air_velocity: NDArray[np.float64], velocity: NDArray[np.float64],
     return force, heat, d
 
 
+#: Rank 0's log of the air's temperature (air.warming), beside the coupling logs.
+AIR_LOG_PATTERN = "coupling/air.{start}.csv"
+AIR_LOG_COLUMNS = ("step", "time_s", "steps", "heat_to_air_W", "air_enthalpy_gain_W",
+                   "outlet_C", "max_C", "wall_s")
+
+
+class _AirWarming:
+    """The coupling loop's air that warms (:mod:`drumflow.air.heat`), one per rank: every rank
+    holds the same grid and solves the same system from the heat summed over all ranks."""
+
+    def __init__(self, spec: dict[str, Any], field: VelocityField, rank: int, start: int) -> None:
+        from drumflow.air.field import AirField
+        from drumflow.air.heat import AirHeat, coarse_field
+
+        if not isinstance(field, AirField):
+            raise ValueError("air.warming needs the air field on a grid (spec field kind 'grid')")
+        warm = spec["warming"]
+        grid = coarse_field(field, float(warm["spacing"])) if warm.get("spacing") else field
+        self.heat = AirHeat(grid, float(spec["air_temperature_C"]), float(warm["density"]),
+                            float(warm["heat_capacity"]))
+        self.omega = float(spec["omega"])
+        self.rank = rank
+        self.cells = np.zeros(0, dtype=np.intp)
+        self._wall = 0.0
+        self._log = None
+        if rank == 0:
+            path = Path(AIR_LOG_PATTERN.format(start=start))
+            path.parent.mkdir(parents=True, exist_ok=True)
+            self._log = path.open("w")
+            self._log.write(",".join(AIR_LOG_COLUMNS) + "\n")
+
+    def air_at(self, x: NDArray[np.float64], time_s: float, conductance: NDArray[np.float64],
+               temperature: NDArray[np.float64]) -> NDArray[np.float64]:
+        """The air temperature each particle sees over the coming interval, C.
+
+        ``conductance`` (W/K) and ``temperature`` (C) are each DEM sphere's film conductance to
+        the air and the temperature behind it (the surface node)."""
+        started = time.perf_counter()
+        from drumflow.air.field import rotate_to_drum_frame
+
+        points = rotate_to_drum_frame(x, self.omega * time_s) if self.omega else x
+        self.cells = self.heat.cells_of(points)
+        g = allreduce_sum(self.heat.deposit(self.cells, conductance))
+        gt = allreduce_sum(self.heat.deposit(self.cells, conductance * temperature))
+        cell_temperature = self.heat.solve_with_particles(g, gt)
+        self._wall = time.perf_counter() - started
+        return np.asarray(cell_temperature[self.cells], dtype=float)
+
+    def record(self, heat_to_particles: NDArray[np.float64], step: int, time_s: float, n: int) -> None:
+        """Log the interval: the heat the air received from every rank's particles and what the
+        air carries out for it (equal by conservation), its outlet and largest temperature."""
+        started = time.perf_counter()
+        source = allreduce_sum(self.heat.deposit(self.cells, -np.asarray(heat_to_particles)))
+        solved = self.heat.solve(source)
+        self._wall += time.perf_counter() - started
+        if self._log is not None:
+            row = (step, time_s, n, float(source.sum()), self.heat.enthalpy_gain(solved),
+                   self.heat.outlet_temperature(solved), float(solved.max()), self._wall)
+            self._log.write(",".join(f"{v:.12g}" for v in row) + "\n")
+            self._log.flush()
+
+    def close(self) -> None:
+        if self._log is not None:
+            self._log.close()
+
+
 def run(spec_path: Path) -> int:
     """Run the coupled loop described by a JSON spec (written by
     :meth:`drumflow.coupling.spec.CouplingSpec.write_driver_file`)."""
@@ -226,6 +300,12 @@ def run(spec_path: Path) -> int:
         lmp.command("undump cross")
     tracker = (CrossingTracker(int(spec["particles"]), work, rank, record_crossings, clock(start))
                if monitor is not None or record_crossings else None)
+    # air.warming: the air's temperature, solved on the field's grid (drumflow.air.heat).
+    warming = _AirWarming(spec, field, rank, start) if spec.get("warming") else None
+    # particles.interior = "shells": each particle's radial profile (drumflow.coupling.interior).
+    interior = (InteriorLoop(InteriorSpec.from_json(spec["interior"]),
+                             Path(INTERIOR_LOG_PATTERN.format(rank=rank, start=start)))
+                if spec.get("interior") else None)
     stopped = False
     # A restart pattern lets an interrupt end the loop with a restart at the current step
     # (module docstring); without one (studies, verification scenes) the loop never looks.
@@ -245,6 +325,31 @@ def run(spec_path: Path) -> int:
             T = lmp.fix_vector("Temp")
             u = air_velocity_at(field, x, clock(step), omega)
             force, heat, d = air_load(u, v, T, 2.0 * lmp.atom_vector("radius"), coarse_grain, air)
+            # The film coefficient, where a level needs it apart from the heat (the lumped
+            # one-way loop has it inside air_load).
+            h = (ranz_marshall_h(np.linalg.norm(u - v, axis=1), d, air)
+                 if warming is not None or interior is not None else np.zeros(0))
+            air_temperature: NDArray[np.float64] | float = air.temperature_C
+            if warming is not None:
+                # Each particle sees the air of its cell, solved with this interval's heat
+                # implicit in it (drumflow.air.heat), from the particle's surface: the outer
+                # shell through its half-shell and the film, or the lumped particle's film.
+                if interior is not None:
+                    g = interior.batch.surface_conductance(h, 0.5 * d)
+                    node = lmp.fix_array(SHELL_FIX, interior.spec.shells)[:, -1].copy()
+                    unset = node <= 0.5 * UNSET
+                    node[unset] = T[unset]
+                else:
+                    g, node = h * np.pi * d**2, np.asarray(T, dtype=float)
+                air_temperature = warming.air_at(x, clock(step), g * coarse_grain**3, node)
+                if interior is None:
+                    heat = g * coarse_grain**3 * (air_temperature - T)
+            if interior is not None:
+                # The heat from each granule's surface, not its mean: the interior's advance.
+                mass = granule(d * coarse_grain, lmp.atom_vector("rmass"), coarse_grain)[1]
+                profiles, heat = interior.advance(lmp.fix_array(SHELL_FIX, interior.spec.shells),
+                                                  T, h, air_temperature, d, mass, n * dt)
+                heat = heat * coarse_grain**3
             found = tracker.update(lmp, clock(step)) if tracker is not None else None
             # After the crossings up to this step are recorded (a resume from this step keeps
             # them), before this update's heat is applied or logged (the resumed attempt
@@ -265,6 +370,11 @@ def run(spec_path: Path) -> int:
                 break
             for axis, name in enumerate(DRAG_FIXES):
                 lmp.fix_vector(name)[:] = force[:, axis]
+            if interior is not None:
+                interior.commit(lmp.fix_array(SHELL_FIX, interior.spec.shells), profiles, h,
+                                air_temperature, d, step, clock(step))
+            if warming is not None:
+                warming.record(heat, step, clock(step), n)
             if heat_capacity is None:
                 lmp.fix_vector("heatSource")[:] = heat
             else:
@@ -298,6 +408,10 @@ def run(spec_path: Path) -> int:
             out.write(f",{time.perf_counter() - ran:.6g}\n")
             out.flush()
             step += n
+    if interior is not None:
+        interior.close()
+    if warming is not None:
+        warming.close()
     if checkpointed:
         # Not finished: no closing commands (final snapshot, end restart), no stop verdict.
         if tracker is not None:

@@ -88,6 +88,18 @@ class Liggghts:
         ptr = self._lib.lammps_extract_fix(self._handle, fix_id.encode(), 1, 1, 0, 0)
         return self._view(ptr, fix_id)
 
+    def fix_array(self, fix_id: str, columns: int) -> NDArray[np.float64]:
+        """A per-atom vector property of a fix (``property/atom ... vector``) as an
+        (nlocal, columns) view; LIGGGHTS keeps each atom's values contiguous."""
+        ptr = self._lib.lammps_extract_fix(self._handle, fix_id.encode(), 1, 2, 0, 0)
+        if not ptr:
+            raise KeyError(f"LIGGGHTS has no per-atom array {fix_id!r}")
+        n = self.nlocal
+        if n == 0:
+            return np.empty((0, columns))
+        rows = C.cast(ptr, C.POINTER(C.POINTER(C.c_double)))
+        return np.ctypeslib.as_array(rows[0], shape=(n, columns))
+
     def _view(self, ptr: int | None, name: str) -> NDArray[np.float64]:
         if not ptr:
             raise KeyError(f"LIGGGHTS has no per-atom quantity {name!r}")

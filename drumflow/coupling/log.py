@@ -22,8 +22,14 @@ WALL_COLUMNS = ("python_wall_s", "liggghts_wall_s")
 PAUSED_FACTOR = 20.0
 
 
+#: Columns of a coupling log that hold the physics: every value a finite number.
+PHYSICS_COLUMNS = ("step", "steps", "heat_to_particles_W", "drag_x_N", "drag_y_N", "drag_z_N",
+                   "particles")
+
+
 def read_coupling(folder: Path, time_step: float,
-                  origin: tuple[int, float] = (0, 0.0)) -> pd.DataFrame:
+                  origin: tuple[int, float] = (0, 0.0),
+                  covers_s: float | None = None) -> pd.DataFrame:
     """One row per coupling update: step, time, steps held, heat (W) and drag (N) on all particles.
 
     ``origin`` is the (step, time) the clock counts from: a run that changed its step at a
@@ -33,6 +39,12 @@ def read_coupling(folder: Path, time_step: float,
     Each rank logs its own particles (``rank<R>.<start step>.csv``); a resumed attempt supersedes
     what earlier attempts logged from its start step on.
 
+    ``covers_s`` (the run's last output time, for ``drumflow post``) makes the read strict: every
+    physics value must be a finite number, and every rank's log of every attempt must reach
+    the next attempt's start (the last attempt: ``covers_s``). A log cut short otherwise sums
+    fewer updates (or fewer ranks) and gives a heat balance that is wrong without a word. A
+    run still going may be mid-line, so the default read is lenient.
+
     Returns
     -------
     pandas.DataFrame
@@ -41,18 +53,36 @@ def read_coupling(folder: Path, time_step: float,
         empty when the run had no air. Logs that record wall times add ``python_wall_s,
         liggghts_wall_s`` last (the slowest rank's wall seconds of the update; NaN for an update
         of an older attempt without them, or one cut by an interrupt).
+
+    Raises
+    ------
+    BadFileError
+        With ``covers_s``: a log that is empty, not a table, holds a non-finite value, or ends
+        before the time it must reach (the file, its last time and that time named).
     """
+    from drumflow.readers import read_csv
+
     attempts: dict[int, list[pd.DataFrame]] = {}
-    for path in folder.glob("rank*.csv"):
+    files: dict[int, list[tuple[Path, pd.DataFrame]]] = {}
+    for path in sorted(folder.glob("rank*.csv")):
         m = _NAME.search(path.name)
         if not m:
             continue
-        frame = pd.read_csv(path)
+        if covers_s is not None:
+            frame = read_csv(path, "a coupling log", columns=PHYSICS_COLUMNS, finite=PHYSICS_COLUMNS)
+        else:
+            try:
+                frame = pd.read_csv(path)
+            except pd.errors.EmptyDataError:  # created, not yet written (a run starting)
+                continue
+        files.setdefault(int(m.group(2)), []).append((path, frame))
         if not frame.empty:
             attempts.setdefault(int(m.group(2)), []).append(frame)
     if not attempts:
         return pd.DataFrame()
     starts = sorted(attempts)
+    if covers_s is not None:
+        _require_coverage(files, starts, time_step, origin, covers_s)
     kept = []
     for i, start in enumerate(starts):
         frame = pd.concat(attempts[start], ignore_index=True)
@@ -77,6 +107,28 @@ def read_coupling(folder: Path, time_step: float,
         return table
     # The wall times after the physics, as in the logs (NaN for an attempt that predates them).
     return table[[c for c in table.columns if c not in present] + present]
+
+
+def _require_coverage(files: dict[int, list[tuple[Path, pd.DataFrame]]], starts: list[int],
+                      time_step: float, origin: tuple[int, float], covers_s: float) -> None:
+    """Refuse a rank's log that ends before its attempt hands over (module notes of
+    :func:`read_coupling`)."""
+    from drumflow.errors import BadFileError
+
+    def at(step: float) -> float:
+        return origin[1] + (step - origin[0]) * time_step
+
+    for i, start in enumerate(starts):
+        until = at(starts[i + 1]) if i + 1 < len(starts) else covers_s
+        for path, frame in files[start]:
+            # An update holds its heat over `steps` DEM steps from its own step on.
+            reached = (at(float(frame["step"].iloc[-1]) + float(frame["steps"].iloc[-1]))
+                       if not frame.empty else at(start))
+            if reached < until - max(1e-9, 1e-9 * abs(until)) - time_step:
+                raise BadFileError(path, f"its updates end at {reached:.6g} s, before {until:.6g} s "
+                                   f"({'the next attempt' if i + 1 < len(starts) else 'the run'}'s "
+                                   "last output): cut short? The heat balance would miss the rest",
+                                   "a coupling log")
 
 
 def heat_removed_until(coupling: pd.DataFrame, t_end: float, time_step: float) -> float:

@@ -16,14 +16,19 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from drumflow.air.source import FieldSource, mean_axial_velocity
-from drumflow.coupling.physics import AirState, auto_coupling_interval
+from drumflow.air_properties import ideal_gas_density
+from drumflow.coolers.particle_interior import shells_for_biot
+from drumflow.coupling.interior import InteriorSpec
+from drumflow.coupling.physics import AirState, auto_coupling_interval, ranz_marshall_h
+from drumflow.geometry.fluid import fluid_mesh_size
 
 if TYPE_CHECKING:
     from drumflow.case import Case
     from drumflow.runner import LaunchProfile
 
 __all__ = ["COUPLING_FILE", "STOPPED_RECORD", "STOP_REQUEST", "CouplingSpec", "FieldSource",
-           "build_coupling", "driver_command", "loop_heat_options"]
+           "build_coupling", "driver_command", "interior_spec", "largest_biot",
+           "loop_heat_options"]
 
 #: The coupling loop's input file, in the DEM working directory.
 COUPLING_FILE = "coupling.json"
@@ -71,6 +76,12 @@ class CouplingSpec:
         Set (J/(kg K)) when the deck has no heat fix (``run.conduction = false``): the loop
         then advances each particle's temperature by its heat over the interval itself. None:
         LIGGGHTS' conduction fix integrates the heat the loop writes into ``heatSource``.
+    interior
+        With ``particles.interior = "shells"``: the granules' shells (the deck holds their
+        temperatures, the loop advances them); None: lumped particles.
+    warming
+        With ``air.warming``: the inlet air's density and heat capacity for the air's
+        temperature (:mod:`drumflow.air.heat`); None: one-way air at its inlet temperature.
     """
 
     field: dict[str, Any]
@@ -81,6 +92,8 @@ class CouplingSpec:
     omega: float
     coarse_grain: float = 1.0
     heat_capacity: float | None = None
+    interior: InteriorSpec | None = None
+    warming: dict[str, float] | None = None
 
     @property
     def key(self) -> str:
@@ -88,7 +101,9 @@ class CouplingSpec:
         parcels = f":parcels={self.coarse_grain:.12g}" if self.coarse_grain != 1.0 else ""
         # A run whose temperatures the loop integrates has another deck and restart content.
         loop_heat = ":heat=loop" if self.heat_capacity is not None else ""
-        return f":air={self.field_key}:every={self.interval}{parcels}{loop_heat}"
+        shells = f":shells={self.interior.shells}" if self.interior is not None else ""
+        warming = ":warming" if self.warming is not None else ""
+        return f":air={self.field_key}:every={self.interval}{parcels}{loop_heat}{shells}{warming}"
 
     def driver_file(self, deck: str, log: str, total_steps: int, time_step: float,
                     tail: list[str], thermo_every: int = 0) -> dict[str, Any]:
@@ -125,6 +140,8 @@ class CouplingSpec:
             "coarse_grain": self.coarse_grain,
             "heat_capacity": None,  # conduction on: LIGGGHTS integrates the temperatures
             **loop_heat,
+            "interior": None if self.interior is None else self.interior.to_json(),
+            "warming": self.warming,
         }
 
     def write_driver_file(self, work: Path, deck: str, log: str, total_steps: int,
@@ -189,7 +206,36 @@ def build_coupling(case: Case, source: FieldSource, time_step: float, dump_every
         # The deck leaves out the conduction fix, which also integrates the temperatures, when
         # conduction is off (templates/drum.in.j2); the loop integrates them instead.
         heat_capacity=None if case.run.conduction else case.particles.heat_capacity,
+        interior=interior_spec(case),
+        warming=({"density": ideal_gas_density(case.air.inlet_temperature_C, case.air.pressure_kPa),
+                  "heat_capacity": case.air.heat_capacity,
+                  # The air's temperature on the CFD's own cell size (drumflow.air.heat).
+                  "spacing": fluid_mesh_size(case)} if case.air.warming else None),
     )
+
+
+def interior_spec(case: Case) -> InteriorSpec | None:
+    """The shells of ``particles.interior = "shells"`` (None for lumped particles).
+
+    Without ``particles.interior_shells`` the count comes from the largest Biot number the case
+    can reach: Ranz-Marshall h at the same slip bound as the 'auto' interval (the air speed plus
+    a granule falling across the whole drum), on the real granule (parcels keep its profile).
+    """
+    p = case.particles
+    if p.interior != "shells":
+        return None
+    shells = p.interior_shells if p.interior_shells is not None else shells_for_biot(largest_biot(case))
+    return InteriorSpec(shells, p.conductivity, p.density, p.heat_capacity)
+
+
+def largest_biot(case: Case) -> float:
+    """The largest Biot number h R / k of the case's granules: Ranz-Marshall h at the slip bound
+    of the 'auto' interval (the air speed plus a fall across the whole drum)."""
+    p = case.particles
+    state = AirState.at(case.air.inlet_temperature_C, case.air.pressure_kPa)
+    max_slip = mean_axial_velocity(case) + math.sqrt(2 * GRAVITY * case.drum.diameter)
+    h = float(ranz_marshall_h(max_slip, p.diameter, state))
+    return h * 0.5 * p.diameter / p.conductivity
 
 
 def driver_command(profile: LaunchProfile, processes: int, spec_name: str = COUPLING_FILE) -> list[str]:

@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING, Any
 
 import jinja2
 
+from drumflow.coupling.interior import shell_fix_command
 from drumflow.dem.conduction import liggghts_conductivity
 from drumflow.dem.restitution import calibrate_case
 from drumflow.dem.stability import CHECK_EVERY_STEPS
@@ -64,6 +65,8 @@ class DeckFiles:
     #: that it is the newest restart: what a settings study or a longer run starts from. A
     #: separate final.restart was a third copy of the same state at the end of a run.
     final_restart: str = "restart/drum.*.restart"
+    #: A start state's particle temperatures (``variable atomfile``, drumflow.dem.state).
+    start_temperatures: str = "start_temperatures.txt"
 
 
 @dataclass(frozen=True)
@@ -184,6 +187,13 @@ def turning_mesh(files: DeckFiles) -> str:
     return "lifters" if files.lifters_stl_file else ""
 
 
+def start_angle_deg(case: Case, plan: StepPlan, step: int) -> float:
+    """The drum angle at ``step`` (omega t, counter-clockwise about +z), degrees in [0, 360): the
+    turning mesh of a run from a start state is read in at it. The angle is that of the run's
+    own clock (step times its time step), which the coupling loop samples the air at."""
+    return math.degrees(case.drum.omega * step * plan.time_step) % 360.0
+
+
 def deck_context(
     case: Case,
     plan: StepPlan,
@@ -192,12 +202,18 @@ def deck_context(
     extra_commands: str = "",
     coupled: bool = False,
     processes: int = 1,
+    shells: int = 0,
+    start_step: int | None = None,
 ) -> dict[str, Any]:
     """All values the template needs.
 
     ``extra_commands`` are LIGGGHTS lines placed just before the run (verification scenes);
     ``processes`` is the MPI process count the domain is decomposed for (from the launch
-    profile, :meth:`drumflow.runner.LaunchProfile.processes_for`).
+    profile, :meth:`drumflow.runner.LaunchProfile.processes_for`); ``shells`` the shells per
+    particle the coupling loop advances (``particles.interior = "shells"``; 0: lumped);
+    ``start_step`` the step a run from a start state begins at (``run.start_state``,
+    :mod:`drumflow.dem.state`: the particles file then holds the state's particles,
+    ``files.start_temperatures`` their temperatures).
     """
     p = case.particles
     cc = case.contacts
@@ -209,7 +225,14 @@ def deck_context(
         "soft_particles": min(p.youngs_modulus, E_wall) < SOFT_PARTICLE_LIMIT,
         "resume": resume_from is not None,
         "restart_file": resume_from or "",
-        "resume_mesh": turning_mesh(files) if resume_from is not None else "",
+        # A start state's deck writes the turning mesh at its set-up too: the lifters must
+        # stand at the state's angle (measured as drumflow.verify.resume measures a resume's).
+        "resume_mesh": (turning_mesh(files)
+                        if resume_from is not None or start_step is not None else ""),
+        "start_state": resume_from is None and start_step is not None,
+        "start_step": start_step or 0,
+        "start_temperatures": files.start_temperatures,
+        "start_angle_deg": f"{start_angle_deg(case, plan, start_step or 0):.12g}",
         "resume_mesh_pattern": RESUME_MESH_PATTERN,
         "data_file": files.data_file,
         "skin": f"{neighbor_skin(case):.6g}",
@@ -259,6 +282,7 @@ def deck_context(
         "extra_commands": extra_commands,
         "coupled": coupled,
         "conduction": case.run.conduction,
+        "shell_fix": shell_fix_command(shells) if shells else "",
         # Not used by the template: the record of how e_pp and e_pw were chosen (manifest).
         "restitution_calibration": {k: v.as_dict() for k, v in restitution.items()},
     }

@@ -27,7 +27,7 @@ import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
-from drumflow.errors import RunDirectoryError
+from drumflow.errors import BadFileError, RunDirectoryError
 
 _STEP_RE = re.compile(r"(\d+)")
 
@@ -65,12 +65,21 @@ def read_dump(path: Path) -> Snapshot:
     Raises
     ------
     RunDirectoryError
-        When the file is not a LIGGGHTS custom dump (names the file and what is wrong).
+        When the file is not a LIGGGHTS custom dump (names the file and what is wrong); a
+        :class:`~drumflow.errors.BadFileError` when it is cut short (inside its header, in a
+        row, or rows missing), not UTF-8, or holds a word where a number belongs.
     """
     if path.suffix == PACKED:
         return _read_packed(path)
-    with path.open("r") as fh:
-        header = [fh.readline() for _ in range(9)]
+    what = "a particle dump of the DEM run"
+    try:
+        with path.open("r", encoding="utf-8") as fh:
+            header = [fh.readline() for _ in range(9)]
+    except UnicodeDecodeError as exc:
+        raise BadFileError(path, f"not UTF-8 text in its header (byte 0x{exc.object[exc.start]:02x})",
+                           what) from None
+    if header[0].startswith("ITEM: TIMESTEP") and not header[8]:
+        raise BadFileError(path, "ends inside its 9-line header: cut short?", what)
     if not header[0].startswith("ITEM: TIMESTEP") or not header[8].startswith("ITEM: ATOMS"):
         raise RunDirectoryError(f"{path}: not a LIGGGHTS custom dump (bad header)")
     try:
@@ -81,43 +90,65 @@ def read_dump(path: Path) -> Snapshot:
     names = [_canonical(n) for n in header[8].split()[2:]]
     if natoms == 0:
         return Snapshot(step, {n: np.empty(0) for n in names})
-    table = pd.read_csv(
-        path,
-        sep=" ",
-        header=None,
-        skiprows=9,
-        usecols=range(len(names)),  # LIGGGHTS ends each row with a space: one empty column
-        dtype=np.float64,
-        engine="c",
-    ).to_numpy()
+    # LIGGGHTS ends every row with a newline. A file cut inside its last row still has the
+    # header's count of rows, the cut one padded with NaN (or a number cut to fewer digits):
+    # the row count cannot see it, the last byte can.
+    with path.open("rb") as fh:
+        fh.seek(-1, os.SEEK_END)
+        if fh.read(1) != b"\n":
+            raise BadFileError(path, "ends inside a row (no end of line after the last one): "
+                               "cut short, or still being written", what)
+    try:
+        table = pd.read_csv(
+            path,
+            sep=" ",
+            header=None,
+            skiprows=9,
+            usecols=range(len(names)),  # LIGGGHTS ends each row with a space: one empty column
+            dtype=np.float64,
+            engine="c",
+        ).to_numpy()
+    except UnicodeDecodeError as exc:
+        raise BadFileError(path, f"not UTF-8 text (byte 0x{exc.object[exc.start]:02x} in the "
+                           "rows)", what) from None
+    except ValueError as exc:  # a word where a number belongs, a row of another width
+        first = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+        raise BadFileError(path, f"not a table of numbers after the header ({first})", what) from None
     if len(table) != natoms:
-        raise RunDirectoryError(
-            f"{path}: header says {natoms} particles, table has {len(table)} (truncated dump?)"
-        )
+        raise BadFileError(path, f"header says {natoms} particles, table has {len(table)} "
+                           "(truncated dump?)", what)
     order = np.argsort(table[:, names.index("id")], kind="stable")
     table = table[order]
     return Snapshot(step, {n: np.ascontiguousarray(table[:, i]) for i, n in enumerate(names)})
 
 
 def _read_packed(path: Path) -> Snapshot:
+    from drumflow.errors import BadFileError
+    from drumflow.readers import read_npz
+
     try:
-        with np.load(path, allow_pickle=False) as data:
-            names = [str(n) for n in data["names"]]
-            step = int(data["step"])
-            # Files packed before constant columns were elided have no row count.
-            rows = int(data["rows"]) if "rows" in data.files else None
-            columns = {}
-            for n in names:
-                if f"first_{n}" in data.files:
-                    if rows is None:
-                        raise ValueError(f"column {n} kept as its first value, but no row count")
-                    columns[n] = np.arange(rows, dtype=np.float64) + float(data[f"first_{n}"])
-                    continue
-                values = np.asarray(data[f"c_{n}"], dtype=np.float64)
-                if rows is not None and values.shape == (1,) and rows != 1:
-                    values = np.full(rows, values[0])
-                columns[n] = np.ascontiguousarray(values)
-    except (OSError, KeyError, ValueError) as exc:
+        data = read_npz(path)
+    except BadFileError as exc:
+        # Still a RunDirectoryError: the readers that skip a newest dump still being written
+        # skip a cut archive (BadZipFile) the same way.
+        raise BadFileError(path, f"not a packed drumflow snapshot ({exc.problem})") from None
+    try:
+        names = [str(n) for n in data["names"]]
+        step = int(data["step"])
+        # Files packed before constant columns were elided have no row count.
+        rows = int(data["rows"]) if "rows" in data else None
+        columns = {}
+        for n in names:
+            if f"first_{n}" in data:
+                if rows is None:
+                    raise ValueError(f"column {n} kept as its first value, but no row count")
+                columns[n] = np.arange(rows, dtype=np.float64) + float(data[f"first_{n}"])
+                continue
+            values = np.asarray(data[f"c_{n}"], dtype=np.float64)
+            if rows is not None and values.shape == (1,) and rows != 1:
+                values = np.full(rows, values[0])
+            columns[n] = np.ascontiguousarray(values)
+    except (KeyError, ValueError) as exc:
         raise RunDirectoryError(f"{path}: not a packed drumflow snapshot ({exc})") from None
     return Snapshot(step, columns)
 

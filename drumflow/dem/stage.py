@@ -16,7 +16,7 @@ import json
 import re
 import time
 from collections.abc import Callable
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -48,6 +48,14 @@ from drumflow.dem.stability import (
     StabilityMonitor,
     stability_limits,
 )
+from drumflow.dem.state import (
+    StartState,
+    check_state,
+    data_file_text,
+    read_state,
+    start_step,
+    temperature_file_text,
+)
 from drumflow.dem.thermo import ThermoParser
 from drumflow.dem.timestep import TimeStepChoice, choose_time_step
 from drumflow.errors import (
@@ -56,6 +64,7 @@ from drumflow.errors import (
     RunDirectoryError,
     RunStoppedError,
     SolverError,
+    StartStateError,
     UnstableRunError,
 )
 from drumflow.rundir import hash_text
@@ -303,9 +312,30 @@ def _stability_record(limits: StabilityLimits, monitor: StabilityMonitor, stoppe
             "max_overlap_m": monitor.max_overlap, "max_kinetic_energy_J": monitor.max_kinetic_energy}
 
 
-def _prepare_workdir(case: Case, rundir: RunDir, inputs: DemInputs, key: str) -> tuple[Path, int] | None:
+def load_start_state(case: Case) -> StartState | None:
+    """The case's start state (``run.start_state``), checked against its scene; None without.
+
+    Raises
+    ------
+    StartStateError
+        The file is not a start state, or it is another scene's or holds another particle count.
+    """
+    if case.run.start_state is None:
+        return None
+    path = Path(case.run.start_state)
+    state = read_state(path)
+    check_state(state, case, path)
+    if case.run.time <= state.time_s:
+        raise StartStateError(
+            case.run.start_state, f"the state is at t = {state.time_s:.6g} s, run.time "
+            f"= {case.run.time:g} s ends before it: run.time is the end time, counted from 0")
+    return state
+
+
+def _prepare_workdir(case: Case, rundir: RunDir, inputs: DemInputs, key: str,
+                     state: StartState | None = None) -> tuple[Path, int] | None:
     """Create the DEM folders; return the restart to resume from, or start afresh (stale
-    outputs removed, particles placed)."""
+    outputs removed, particles placed, or taken from the start state ``state``)."""
     rundir.dem_dumps.mkdir(parents=True, exist_ok=True)
     rundir.dem_restart.mkdir(parents=True, exist_ok=True)
     resume = None
@@ -319,16 +349,22 @@ def _prepare_workdir(case: Case, rundir: RunDir, inputs: DemInputs, key: str) ->
                  *rundir.dem_coupling_logs.glob("*.json")]
         for old in stale:
             old.unlink()
-        positions = place_particles(case, case.particle_count)
         box = (inputs.geometry.box_lo, inputs.geometry.box_hi)
-        write_data_file(case, positions, rundir.dem / "particles.data", box)
+        if state is not None:
+            (rundir.dem / "particles.data").write_text(data_file_text(state, case, box))
+            (rundir.dem / DeckFiles.start_temperatures).write_text(temperature_file_text(state))
+        else:
+            positions = place_particles(case, case.particle_count)
+            write_data_file(case, positions, rundir.dem / "particles.data", box)
     rundir.record("dem_key", key)
     return resume
 
 
 def write_deck(case: Case, rundir: RunDir, inputs: DemInputs,
-                resume: tuple[Path, int] | None) -> tuple[str, dict[str, Any]]:
-    """Render the deck (fresh or resume) and record what it chose; return its name and context."""
+                resume: tuple[Path, int] | None,
+                first_step: int | None = None) -> tuple[str, dict[str, Any]]:
+    """Render the deck (fresh, from a start state at ``first_step``, or resume) and record what
+    it chose; return its name and context."""
     geometry = inputs.geometry
     files = DeckFiles(
         stl_file=str(Path("..") / geometry.stl),
@@ -343,6 +379,9 @@ def write_deck(case: Case, rundir: RunDir, inputs: DemInputs,
         extra_commands=inputs.extra_commands,
         coupled=inputs.coupling is not None,
         processes=inputs.processes,
+        shells=(inputs.coupling.interior.shells
+                if inputs.coupling is not None and inputs.coupling.interior is not None else 0),
+        start_step=first_step if resume is None else None,
     )
     deck_name = "in.drum" if resume is None else "in.drum.resume"
     (rundir.dem / deck_name).write_text(render_deck(context))
@@ -482,8 +521,24 @@ def run(case: Case, rundir: RunDir, runner: Runner, inputs: DemInputs) -> DemRes
     done = rundir.stage_done("dem", key)
     if done:
         return DemResult(**done["result"])
-    resume = _prepare_workdir(case, rundir, inputs, key)
-    deck_name, context = write_deck(case, rundir, inputs, resume)
+    state = load_start_state(case)
+    first_step = None if state is None else start_step(state, inputs.plan.time_step)
+    if state is not None and first_step is not None:
+        if inputs.steps is not None:
+            # A short start-up check runs its steps from the state's step (the plan counts
+            # from step 0, as LIGGGHTS' `run N upto` and the coupling loop's total do).
+            inputs = replace(inputs, plan=replace(inputs.plan, steps=first_step + inputs.steps))
+        elif inputs.plan.steps <= first_step:
+            raise StartStateError(
+                case.run.start_state or "", f"the state is at t = {state.time_s:.6g} s, run.time "
+                f"= {case.run.time:g} s ends before it: run.time is the end time, counted from 0")
+    resume = _prepare_workdir(case, rundir, inputs, key, state)
+    if state is not None and resume is None:
+        rundir.record("start_state", {
+            "file": case.run.start_state, "time_s": state.time_s, "step": first_step,
+            "source_case_hash": state.case_hash, "source": state.source,
+            "drumflow_version": state.drumflow_version})
+    deck_name, context = write_deck(case, rundir, inputs, resume, first_step)
     suffix = "" if resume is None else f".resume-{resume[1]}"
     watcher, log, wall = _launch(case, rundir, runner, inputs, deck_name, context, suffix)
     rows = watcher.parser.rows
@@ -502,7 +557,7 @@ def run(case: Case, rundir: RunDir, runner: Runner, inputs: DemInputs) -> DemRes
     steps = int(stop["step"]) if stop else plan.steps
     if stop:
         rundir.record("stop", stop)
-    steps_run = steps - (resume[1] if resume else 0)
+    steps_run = steps - (resume[1] if resume else first_step or 0)
     result = DemResult(
         time_step=plan.time_step,
         steps=steps,

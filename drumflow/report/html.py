@@ -45,10 +45,12 @@ from drumflow.analysis.methodology import (
 from drumflow.case import Case, load_case
 from drumflow.errors import (
     AnalysisInputError,
+    BadFileError,
     DrumflowError,
     RenderError,
     RunDirectoryError,
 )
+from drumflow.readers import read_json_object
 from drumflow.rundir import RunDir
 
 __all__ = ["write_report"]
@@ -142,11 +144,11 @@ def _fig_uri(draw: Callable[[Any], None], size: tuple[float, float] = (6.4, 3.8)
 
 
 def _read_json(path: Path) -> dict[str, Any] | None:
-    try:
-        data = json.loads(path.read_text())
-    except (OSError, ValueError):
+    """A run's JSON object, or None when the file is missing; a damaged one (cut short, not
+    UTF-8, not an object) is refused by name rather than left out of the page."""
+    if not path.exists():
         return None
-    return data if isinstance(data, dict) else None
+    return read_json_object(path)
 
 
 def _anchor(i: int, name: str) -> str:
@@ -312,7 +314,7 @@ def _run_view(i: int, run: RunDir, result: MethodologyResult | None, why_not: st
     if summary is not None:
         view.tables.append(_summary_table(summary))
     else:
-        view.notes.append(f"no summary: {run.summary_path} is missing or not JSON")
+        view.notes.append(f"no summary: {run.summary_path} is missing")
     manifest = _read_json(run.manifest_path)
     view.manifest_json = json.dumps(manifest, indent=2, sort_keys=False) if manifest else None
 
@@ -529,6 +531,7 @@ def write_report(
     falling_mass: FallingMassMode = "mean",
     render_3d: bool = True,
     render_timeout_s: float = 180.0,
+    on_note: Callable[[str], None] | None = None,
 ) -> Path:
     """Write one self-contained HTML page for one run or a sweep of runs.
 
@@ -544,6 +547,10 @@ def write_report(
         Render the last snapshot with PyVista (Figure 6). Off makes the page faster.
     render_timeout_s
         Time limit of each PyVista render (it runs in a child process).
+    on_note
+        Called with every note the page carries (what was not applied or not drawn, and why),
+        each prefixed with its run's name: a caller that prints them keeps them from being
+        seen only by whoever opens the page.
 
     Returns
     -------
@@ -554,6 +561,9 @@ def write_report(
     ------
     RunDirectoryError
         If no run directory is given or one of them is not a directory.
+    BadFileError
+        If a file of a run is damaged (cut short, not UTF-8, a series that ends before the
+        run): refused, not turned into a note.
     """
     from jinja2 import Environment, PackageLoader, StrictUndefined
 
@@ -571,6 +581,9 @@ def write_report(
             results.append(analyse_run(root, nusselt_conductivity=nusselt_conductivity,
                                        falling_mass=falling_mass))
             why_not.append(None)
+        except BadFileError:
+            # A damaged file is refused: a note would let a cut-short series pass as a run.
+            raise
         except DrumflowError as exc:
             # A run without air or without its CSV still gets its page, with the reason.
             results.append(None)
@@ -605,6 +618,17 @@ def write_report(
             f"{len(results) - len(ok)} of {len(results)} run(s) could not be analysed for heat "
             "transfer; their observables are shown below with the reason."
         )
+    if on_note is not None:
+        for note in page_notes:
+            on_note(note)
+        for view in views:
+            for note in view.notes:
+                on_note(f"{view.name}: {note}")
+            for fig in view.figures:
+                if fig.note:
+                    on_note(f"{view.name}: {fig.title}: {fig.note}")
+        if no_fit:
+            on_note(f"Table 8 (correlation): {no_fit}")
     title = (
         f"drumflow report: {names[0]}" if len(names) == 1
         else f"drumflow report: sweep of {len(names)} runs"

@@ -60,7 +60,8 @@ from drumflow.analysis.paper import (
 )
 from drumflow.case import Case, load_case
 from drumflow.coupling.physics import AirState, ranz_marshall_slip
-from drumflow.errors import AnalysisInputError, DrumflowError, RunDirectoryError
+from drumflow.errors import AnalysisInputError, BadFileError, DrumflowError, RunDirectoryError
+from drumflow.readers import reaches_time, read_csv, read_json_object
 from drumflow.report.animation import ANIMATION, render_animation
 from drumflow.report.html import (
     _fig_uri,
@@ -108,11 +109,26 @@ def is_shipped(root: Path) -> bool:
 
 
 def _read_json(path: Path) -> dict[str, Any] | None:
-    try:
-        data = json.loads(path.read_text())
-    except (OSError, ValueError):
+    """A JSON object of the run, or None when the file is missing; a damaged one (cut short,
+    not UTF-8, not an object) is refused by name: dropping it would redraw the page without
+    it, and without a word."""
+    if not path.exists():
         return None
-    return data if isinstance(data, dict) else None
+    return read_json_object(path)
+
+
+#: Columns of post/mean_temperature.csv the page reads, every value a finite number.
+_SERIES_COLUMNS = ("time_s", "mean_temperature_C")
+#: Columns of post/air_heat.csv the page reads (the wall times may be empty).
+_AIR_HEAT_COLUMNS = ("step", "time_s", "steps", "heat_to_particles_W")
+
+
+def _read_series(run: RunDir) -> pd.DataFrame:
+    """post/mean_temperature.csv, checked, and refused when it ends before the run does."""
+    series = read_csv(run.mean_temperature_csv, "mean particle temperature per output step",
+                      columns=_SERIES_COLUMNS, finite=_SERIES_COLUMNS, min_rows=1)
+    reaches_time(run.mean_temperature_csv, float(series["time_s"].iloc[-1]), run.summary_path)
+    return series
 
 
 def _time_step(run: RunDir) -> float | None:
@@ -181,8 +197,9 @@ def run_record(root: Path | str) -> dict[str, Any]:
     simulated = summary.get("simulated_time_s")
     source = "summary.json"
     if simulated is None and run.mean_temperature_csv.is_file():
-        times = pd.read_csv(run.mean_temperature_csv, usecols=["time_s"])["time_s"]
-        simulated, source = (float(times.iloc[-1]) if len(times) else None), "post/mean_temperature.csv"
+        times = read_csv(run.mean_temperature_csv, "mean particle temperature per output step",
+                         columns=("time_s",), finite=("time_s",), min_rows=1)["time_s"]
+        simulated, source = float(times.iloc[-1]), "post/mean_temperature.csv"
     dt = _time_step(run)
     if simulated is None and dt is not None:
         from drumflow.dem.dumps import dump_files
@@ -461,6 +478,9 @@ def collect_paper_run(root: Path | str, model: Model, *, render_3d: bool = True,
         methodology = analyse_run(run.root, nusselt_conductivity="particle")
         if kind == "run":
             write_methodology(run.root, methodology)
+    except BadFileError:
+        # A damaged file is refused: as a note, a cut-short series would pass as a short run.
+        raise
     except DrumflowError as exc:
         # Too short, no air, no post-processing yet: the reason is part of the result.
         notes.append(f"methodology (Tables 6-8) not applied: {exc}")
@@ -468,7 +488,7 @@ def collect_paper_run(root: Path | str, model: Model, *, render_3d: bool = True,
     temperature: float | None = None
     series: pd.DataFrame | None = None
     if run.mean_temperature_csv.is_file():
-        series = pd.read_csv(run.mean_temperature_csv)
+        series = _read_series(run)
         try:
             temperature = temperature_at(series["time_s"].to_numpy(float),
                                          series["mean_temperature_C"].to_numpy(float), AT_S)
@@ -481,7 +501,9 @@ def collect_paper_run(root: Path | str, model: Model, *, render_3d: bool = True,
     coupling: CouplingH | None = None
     if case is not None and series is not None and run.air_heat_csv.is_file():
         try:
-            coupling = coupling_h(case, pd.read_csv(run.air_heat_csv), series)
+            air_heat = read_csv(run.air_heat_csv, "the heat the air took at each coupling update",
+                                columns=_AIR_HEAT_COLUMNS, finite=_AIR_HEAT_COLUMNS, min_rows=1)
+            coupling = coupling_h(case, air_heat, series)
         except AnalysisInputError as exc:
             notes.append(f"h from the coupling log: {exc}")
     elif case is not None and series is not None:

@@ -21,7 +21,6 @@ Library code: writes files and returns what it wrote; ``drumflow.cli_export`` pr
 
 from __future__ import annotations
 
-import json
 import math
 from dataclasses import asdict, dataclass
 from pathlib import Path
@@ -34,7 +33,8 @@ from numpy.typing import NDArray
 from drumflow.case import load_case
 from drumflow.coupling.spec import COUPLING_FILE
 from drumflow.dem.dumps import dump_files, read_dump
-from drumflow.errors import RunDirectoryError
+from drumflow.errors import BadFileError, RunDirectoryError
+from drumflow.readers import read_json_object
 from drumflow.rundir import RunDir
 
 if TYPE_CHECKING:
@@ -94,9 +94,13 @@ def _walls(rundir: RunDir) -> tuple[pv.PolyData | None, pv.PolyData]:
     import pyvista as pv
 
     marker = rundir.stages / "geometry.json"
-    if not marker.exists():
+    record = rundir.stage_record("geometry")  # checked: a cut marker is named, not a traceback
+    if record is None:
         raise RunDirectoryError(f"{marker}: missing (the geometry stage did not finish)")
-    geometry = json.loads(marker.read_text())["result"]
+    geometry = record.get("result")
+    if not isinstance(geometry, dict) or not isinstance(geometry.get("stl"), str):
+        raise BadFileError(marker, f"result = {geometry!r}: expected the stage's result with the "
+                           "wall file's path (stl)", "the record that the geometry stage finished")
 
     def read_stl(relative: str) -> pv.PolyData:
         mesh = pv.read(str(rundir.root / relative))
@@ -126,7 +130,14 @@ def _air_grid(rundir: RunDir, case: Case) -> pv.ImageData | None:
 
         field = AirField.uniform(case)
         spec_file = rundir.dem / COUPLING_FILE
-        spec = json.loads(spec_file.read_text())["field"] if spec_file.exists() else {}
+        spec: dict[str, Any] = {}
+        if spec_file.exists():
+            what = "the coupling loop's input"
+            applied = read_json_object(spec_file, what).get("field")
+            if not isinstance(applied, dict):
+                raise BadFileError(spec_file, f"field = {applied!r}: expected an object (the air "
+                                   "the coupling loop applied)", what)
+            spec = applied
         velocity = spec.get("velocity") or uniform_field(case).field["velocity"]
         field.velocity[...] = np.asarray(velocity, dtype=float)
     else:
@@ -159,6 +170,9 @@ def export_vtk(run_dir: Path | str, out: Path | str | None = None) -> VtkExport:
     ------
     RunDirectoryError
         When the run directory lacks the case, the time step, the geometry or the snapshots.
+    BadFileError
+        A snapshot, the geometry stage's marker or the coupling input is damaged (cut short,
+        not UTF-8, a word where a number belongs).
     """
     import pyvista as pv
 

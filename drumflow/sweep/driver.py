@@ -32,6 +32,8 @@ from pathlib import Path
 from typing import Any
 
 from drumflow.dem.thermo import ThermoParser, log_files
+from drumflow.errors import BadFileError
+from drumflow.readers import read_json_object
 from drumflow.rundir import software_versions
 from drumflow.sweep.executor import Attempt, Executor, Ledger, log_tail
 from drumflow.sweep.spec import Member, Sweep, SweepError, format_value, load_sweep
@@ -42,14 +44,28 @@ __all__ = ["MemberStatus", "SweepDir", "SweepOutcome", "member_done", "open_swee
 SWEEP_FILE = "sweep.toml"
 BASE_FILE = "base.toml"
 STATE_FILE = "sweep.json"
+_STATE_WHAT = "the sweep's members and sessions"
 
 
 def member_done(run_dir: Path, case_hash: str) -> bool:
-    """True when the run directory holds a finished, healthy run of this case."""
-    try:
-        summary = json.loads((run_dir / "summary.json").read_text())
-    except (OSError, ValueError):
+    """True when the run directory holds a finished, healthy run of this case.
+
+    Raises
+    ------
+    BadFileError
+        The member's ``summary.json`` is there but damaged (cut short, not UTF-8, not an
+        object). It is refused, not read as "not done": a damaged summary is no run being
+        finished (``drumflow run`` writes it whole, then renames it), and a done member taken
+        as pending would silently drop out of ``--analyse`` or be run again.
+    """
+    path = run_dir / "summary.json"
+    if not path.exists():
         return False
+    try:
+        summary = read_json_object(path, "the member's run summary")
+    except BadFileError as exc:
+        raise BadFileError(path, exc.problem + f"; delete it and rerun `drumflow post {run_dir}` "
+                           "to write it again", "the member's run summary") from None
     return (summary.get("case_hash") == case_hash and summary.get("status") == "ok"
             and "short_run_steps" not in summary)
 
@@ -127,6 +143,9 @@ class SweepDir:
     root: Path
     sweep: Sweep
     members: list[Member]
+    #: True when this session made the directory (open_sweep from a sweep file into a new
+    #: folder): a session refused before any member ran may then remove it, and only then.
+    created: bool = False
     ledger: Ledger = field(init=False)
 
     def __post_init__(self) -> None:
@@ -141,7 +160,7 @@ class SweepDir:
     def record_session(self, executor: Executor) -> None:
         """Append this session's executor settings and software versions to sweep.json."""
         path = self.root / STATE_FILE
-        state = json.loads(path.read_text())
+        state = read_json_object(path, _STATE_WHAT)
         state.setdefault("sessions", []).append({
             "started": time.strftime("%Y-%m-%dT%H:%M:%S%z"), "host": socket.gethostname(),
             "executor": executor.describe(), "versions": software_versions(),
@@ -162,14 +181,20 @@ def open_sweep(target: Path, out: Path | None = None) -> SweepDir:
     SweepError
         The sweep file is invalid, a member is a case the model refuses, or ``out`` holds a
         different sweep.
+    BadFileError
+        A member's ``manifest.json`` or the directory's ``sweep.json`` or
+        ``executor/attempts.json`` is damaged.
     """
     target = Path(target)
     if target.is_dir():
-        if out is not None and out.resolve() != target.resolve():
-            raise SweepError([f"--out {out}: give --out only with a sweep file, not a sweep directory"])
         root = target.resolve()
+        # What the target is comes first: a folder that is no sweep directory is the mistake,
+        # whatever --out says.
         if not (root / SWEEP_FILE).is_file():
-            raise SweepError([f"{root}: not a sweep directory (no {SWEEP_FILE}); give a sweep file"])
+            raise SweepError([f"{root}: a directory, not a sweep file, and not a sweep directory "
+                              f"(no {SWEEP_FILE}); give a sweep file (TOML) or a sweep directory"])
+        if out is not None and out.resolve() != root:
+            raise SweepError([f"--out {out}: give --out only with a sweep file, not a sweep directory"])
         sweep, _, members = load_sweep(root / SWEEP_FILE, base=root / BASE_FILE)
         return SweepDir(root, sweep, members)
     sweep, _, members = load_sweep(target)
@@ -178,13 +203,14 @@ def open_sweep(target: Path, out: Path | None = None) -> SweepDir:
     for m in members:
         manifest = root / "members" / m.id / "manifest.json"
         if manifest.exists():
-            old = json.loads(manifest.read_text()).get("case_hash")
+            old = read_json_object(manifest, f"the manifest of member {m.id}").get("case_hash")
             if old and old != m.hash:
                 clashes.append(f"member {m.id} ({m.label()}): {root / 'members' / m.id} holds a "
                                f"run of another case (hash {old[:12]}, now {m.hash[:12]})")
     if clashes:
         raise SweepError(clashes + ["the sweep file changed since this directory was run; "
                                     "choose another --out directory"], target)
+    created = not root.exists()
     root.mkdir(parents=True, exist_ok=True)
     shutil.copyfile(target, root / SWEEP_FILE)
     shutil.copyfile(target.parent / sweep.base, root / BASE_FILE)
@@ -194,7 +220,7 @@ def open_sweep(target: Path, out: Path | None = None) -> SweepDir:
         if not (d / "case.toml").exists() or (d / "case.toml").read_text() != m.case_toml:
             (d / "case.toml").write_text(m.case_toml)
     state_path = root / STATE_FILE
-    state = json.loads(state_path.read_text()) if state_path.exists() else {}
+    state = read_json_object(state_path, _STATE_WHAT) if state_path.exists() else {}
     state.update({
         "sweep": sweep.model_dump(mode="json"),
         "source": str(target.resolve()),
@@ -202,7 +228,7 @@ def open_sweep(target: Path, out: Path | None = None) -> SweepDir:
                     for m in members],
     })
     state_path.write_text(json.dumps(state, indent=2, default=str))
-    return SweepDir(root, sweep, members)
+    return SweepDir(root, sweep, members, created=created)
 
 
 class _Eta:

@@ -23,6 +23,8 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any, Literal
 
+from drumflow.errors import BadFileError
+from drumflow.readers import read_json
 from drumflow.sweep.spec import Member
 
 __all__ = ["ATTEMPTS_FILE", "Attempt", "AttemptState", "Executor", "Ledger", "log_tail"]
@@ -91,7 +93,33 @@ class Ledger:
         self.path = root / ATTEMPTS_FILE
         self.attempts: list[Attempt] = []
         if self.path.exists():
-            self.attempts = [Attempt(**a) for a in json.loads(self.path.read_text())]
+            self.attempts = self._read(self.path)
+
+    @staticmethod
+    def _read(path: Path) -> list[Attempt]:
+        """The attempts of ``path``, each checked (it is saved whole: one that does not read
+        was damaged, and a session guessing would run members again or lose their history).
+
+        Raises
+        ------
+        BadFileError
+            Not a JSON list of attempt records (cut short, not UTF-8, an unknown field).
+        """
+        what = "every attempt of the sweep's members"
+        data = read_json(path, what)
+        if not isinstance(data, list):
+            raise BadFileError(path, f"holds a JSON {type(data).__name__}, expected a list of "
+                               "attempts ([{...}, ...])", what)
+        attempts = []
+        for i, record in enumerate(data):
+            try:
+                if not isinstance(record, dict):
+                    raise TypeError(f"a JSON {type(record).__name__}, expected an object")
+                attempts.append(Attempt(**record))
+            except TypeError as exc:
+                raise BadFileError(path, f"attempt {i + 1}: not an attempt record ({exc})",
+                                   what) from None
+        return attempts
 
     def add(self, attempt: Attempt) -> Attempt:
         self.attempts.append(attempt)

@@ -35,7 +35,8 @@ from datetime import datetime
 from pathlib import Path
 from typing import Any
 
-from drumflow.errors import EXIT_INTERRUPTED, SlurmError
+from drumflow.errors import EXIT_INTERRUPTED, BadFileError, SlurmError
+from drumflow.readers import read_json, read_json_object
 from drumflow.sweep.executor import Attempt, Executor, Ledger
 from drumflow.sweep.spec import Member, Runs, SlurmSettings, SweepError, member_id
 
@@ -235,7 +236,7 @@ exit $rc
             raise SlurmError(f"sbatch printed no job id: {out.stdout.strip()!r}")
         now = time.time()
         path = self.dir / "submissions.json"
-        subs = json.loads(path.read_text()) if path.exists() else []
+        subs = self._submissions(path)
         subs.append({
             "array_job_id": job, "members": [m.id for m in members], "indices": indices,
             "command": command, "submitted": now,
@@ -246,6 +247,25 @@ exit $rc
             ledger.add(Attempt(member=m.id, executor=self.kind, job_id=f"{job}_{m.index}",
                                submitted=now, log=str(self.dir / "logs" / f"{job}_{m.index}.out")))
         ledger.save()
+
+    @staticmethod
+    def _submissions(path: Path) -> list[Any]:
+        """The submissions recorded so far (none when ``path`` is missing).
+
+        Raises
+        ------
+        BadFileError
+            ``path`` is damaged or not a JSON list: appending to a guess would drop the
+            record of job arrays already on the cluster.
+        """
+        if not path.exists():
+            return []
+        what = "the job arrays this sweep submitted"
+        subs = read_json(path, what)
+        if not isinstance(subs, list):
+            raise BadFileError(path, f"holds a JSON {type(subs).__name__}, expected a list of "
+                               "submissions ([{...}, ...])", what)
+        return subs
 
     def poll(self, ledger: Ledger) -> None:
         active = ledger.active(self.kind)
@@ -365,9 +385,25 @@ exit $rc
                 attempt.reason = "stopped after writing a restart; resumed on rerun"
 
     def _own_record(self, attempt: Attempt) -> dict[str, Any] | None:
+        """The end record the task's script wrote (None when it wrote none: killed).
+
+        Read only for a task that left the queue, so after its script finished writing it; a
+        damaged one is refused rather than taken as "no record", which would settle the
+        attempt as failed (or miss an exit code 130, a stop to resume) on a guess.
+
+        Raises
+        ------
+        BadFileError
+            The record is cut short, not UTF-8, not an object, or its ``exit_code`` is not a
+            whole number.
+        """
         path = self.root / "members" / attempt.member / f"slurm-{attempt.job_id}.json"
-        try:
-            data = json.loads(path.read_text())
-        except (OSError, ValueError):
+        if not path.exists():
             return None
-        return data if isinstance(data, dict) else None
+        what = f"the end record of SLURM task {attempt.job_id}"
+        data = read_json_object(path, what)
+        code = data.get("exit_code")
+        if not isinstance(code, int) or isinstance(code, bool):
+            raise BadFileError(path, f"exit_code = {code!r}: expected the member's exit status, a "
+                               "whole number; delete the file to let SLURM's record decide", what)
+        return data

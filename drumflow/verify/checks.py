@@ -7,7 +7,8 @@ Every check says what it is compared with (``kind``):
   the solver does not enforce by construction);
 * ``bookkeeping``: the same quantity reached by two routes through drumflow's own data (heat
   logged by the coupling loop against the enthalpy LIGGGHTS integrated from that same heat,
-  mass flow in against out of a finite-volume solution). These close to round-off by
+  mass flow in against out of a finite-volume solution, a held particle's cooling every N
+  steps against the explicit hold formed from drumflow's own h). These close to round-off by
   construction: they catch broken plumbing (a lost log row, a wrong unit), not wrong physics,
   so their tolerances sit near round-off and :func:`summary` counts them apart.
 """

@@ -15,6 +15,7 @@ from pathlib import Path
 
 from drumflow.runner import Runner
 from drumflow.verify.air_field import air_field_checks, pipe_friction_check
+from drumflow.verify.air_heat import air_heat_check
 from drumflow.verify.bed import conduction_conservation, uniform_air_bed
 from drumflow.verify.checks import Check, summary
 from drumflow.verify.contacts import (
@@ -22,6 +23,7 @@ from drumflow.verify.contacts import (
     restitution_check,
     wall_restitution_check,
 )
+from drumflow.verify.interior import BIOTS, interior_series_check
 from drumflow.verify.references import air_property_checks, drag_curve_check
 from drumflow.verify.single_particle import (
     SETTLING_DIAMETERS,
@@ -61,6 +63,8 @@ def verification_steps(out: Path, runner: Runner, quick: bool) -> list[Callable[
         lambda: [convective_h_check(out / "convective_h_1ms", runner, speed=1.0)],
         lambda: [convective_h_check(out / "convective_h_3ms", runner, speed=3.0)],
         lambda: [settling_check(out / f"settling_{d * 1e3:g}mm", runner, d) for d in SETTLING_DIAMETERS],
+        lambda: [interior_series_check(out / f"interior_bi{b:g}", runner, b) for b in BIOTS],
+        lambda: [air_heat_check(out / "air_warming", runner)],
         lambda: [conduction_conservation(out / "conduction")],
         lambda: uniform_air_bed(out / "uniform_air_bed"),
         lambda: air_field_checks(out / "air_field", runner),

@@ -1,6 +1,7 @@
 """A sweep of tiny drums on a real one-node SLURM cluster, against the local executor.
 
-The cluster is this machine (scripts/slurm_localhost.sh: munged, slurmctld, slurmd). Four
+The cluster is this machine (scripts/slurm_localhost.sh: munged, slurmctld, slurmd), started for
+the session and the daemons it started stopped at its end (support/slurm.py). Four
 members run as one job array; one member's array task is cancelled mid-run (scancel, after
 it wrote a restart file); the sweep reports it failed with its log tail; ``--requeue-failed``
 resubmits only that member, which resumes from its restart. Every member must end done with
@@ -10,47 +11,32 @@ the same results as the same sweep run by the local executor.
 from __future__ import annotations
 
 import json
-import os
-import shutil
 import subprocess
 import sys
 import time
+from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
 import tomli_w
+from support.requirements import missing
+from support.slurm import localhost_cluster
+from support.solvers import LIGGGHTS, requires_solver
 
 from drumflow.sweep.driver import simulated_time
 
-ROOT = Path(__file__).resolve().parents[2]
-
-pytestmark = [
-    pytest.mark.solver,
-    pytest.mark.skipif(shutil.which("liggghts") is None,
-                       reason="LIGGGHTS not installed (scripts/install.sh)"),
-]
+pytestmark = [pytest.mark.solver, requires_solver(*LIGGGHTS)]
 
 
-@pytest.fixture(scope="module")
-def slurm_cluster() -> None:
-    """Start (or find) the localhost SLURM cluster; skip only where SLURM cannot run at all."""
-    ci = os.environ.get("CI", "").lower() == "true"
-    reason = None
-    if shutil.which("sbatch") is None or not Path("/usr/sbin/slurmctld").exists():
-        reason = "SLURM not installed (scripts/install.sh installs slurmctld slurmd munge slurm-client)"
-    elif os.geteuid() != 0 and shutil.which("sudo") is None:
-        reason = "starting slurmctld/slurmd needs root or sudo"
-    if reason is None:
-        proc = subprocess.run([str(ROOT / "scripts" / "slurm_localhost.sh")], capture_output=True,
-                              text=True, timeout=180)
-        if proc.returncode == 4:
-            reason = f"a slurm.conf not written by drumflow is in place: {proc.stderr.strip()}"
-        elif proc.returncode != 0:
-            pytest.fail(f"scripts/slurm_localhost.sh failed ({proc.returncode}): {proc.stderr[-2000:]}")
-    if reason is not None:
-        if ci:
-            pytest.fail(f"CI=true but SLURM cannot run here: {reason}")
-        pytest.skip(reason)
+@pytest.fixture(scope="session")
+def slurm_cluster() -> Iterator[None]:
+    """The localhost SLURM cluster, for the session: started (or found) before the first test;
+    the daemons it started stopped after the last (support/slurm.py). Where SLURM cannot run:
+    skipped on a workstation, failed under CI (support/requirements.py)."""
+    with localhost_cluster() as problem:
+        if problem is not None:
+            missing(*problem)
+        yield
 
 
 def _sweep_file(tmp_path: Path, kind: str) -> Path:

@@ -3,16 +3,18 @@
 A test that needs an external program says so with ``@requires_solver("liggghts", "mpirun")``
 (or as a module's ``pytestmark``); the hook in ``tests/conftest.py`` skips it when a program is
 missing on a developer's machine and fails it under CI (``CI`` set to true, as every CI service
-does): a broken install must not turn the solver suite into a pass.
+does): a broken install must not turn the solver suite into a pass. The rule is
+:mod:`support.requirements`, shared with the Chromium, CoolProp and SLURM tests.
 """
 
 from __future__ import annotations
 
-import os
 from pathlib import Path
 from typing import Any
 
 import pytest
+
+from support.requirements import under_ci as under_ci  # re-exported for older imports
 
 ROOT = Path(__file__).resolve().parents[2]
 CASES = ROOT / "cases"
@@ -30,11 +32,6 @@ OPENFOAM = ("simpleFoam",)
 def requires_solver(*programs: str) -> pytest.MarkDecorator:
     """Mark a test (or module) as needing these programs on PATH."""
     return pytest.mark.requires_solver(*programs)
-
-
-def under_ci() -> bool:
-    """True when the ``CI`` environment variable says so (``true``, ``1`` or ``yes``)."""
-    return os.environ.get("CI", "").strip().lower() in {"true", "1", "yes"}
 
 
 def tiny_case_dict(**overrides: Any) -> dict[str, Any]:

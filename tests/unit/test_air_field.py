@@ -184,6 +184,8 @@ def test_cache_key_follows_drum_and_air_but_not_particles(smoke_dict: dict[str, 
     for section, values in affecting:
         assert changed(section, **values) != key, (section, values)
     neutral: list[tuple[str, dict[str, Any]]] = [
+        ("air", {"warming": True}),
+        ("particles", {"interior": "shells"}),
         ("particles", {"count": 1000}),
         ("particles", {"diameter": 0.006}),
         ("contacts", {"wall_youngs_modulus": 1e7}),
@@ -271,3 +273,15 @@ def test_check_mesh_parser() -> None:
     assert info["min_volume"] == pytest.approx(1.6e-8)
     assert info["max_non_orthogonality"] == pytest.approx(75.4)
     assert not parse_check_mesh(text.replace("Mesh OK.", "Failed 1 mesh checks."))["ok"]
+
+
+def test_cache_key_of_a_shipped_case_is_pinned() -> None:
+    """Regression: adding ``air.warming`` put a new key into the air section and moved every
+    case's air key, so every cached field was solved again and every run keyed on its field
+    restarted its DEM stage (paper model two's parcels began re-solving their air). The key of
+    the shipped model two, computed before that option existed, must not move; a case-file
+    change to model two's drum, lifters or air is the only reason to update it."""
+    from drumflow.case import load_case
+
+    case = load_case(Path(__file__).resolve().parents[2] / "cases" / "paper_model_two.toml")
+    assert air_cache_key(case) == "15be31a7e0d79cc9014c38105f9d5242817ae1da1733ccf915f5784174c9cd76"

@@ -14,8 +14,10 @@ import pytest
     ("args", "message"),
     [
         (["--vtk"], "not a directory"),
-        ([], "choose one export format: --vtk or --animation"),
-        (["--vtk", "--animation"], "choose one export format: --vtk or --animation"),
+        ([], "choose one export format: --vtk, --animation or --state"),
+        (["--vtk", "--animation"], "choose one export format: --vtk, --animation or --state"),
+        (["--vtk", "--time", "1.0"], "--time is for --state"),
+        (["--state"], "no case.toml"),
     ],
 )
 def test_export_bad_input(tmp_path: Path, args: list[str], message: str) -> None:

@@ -11,17 +11,13 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from support.chromium import CHROMIUM, assert_pictures_drawn, shots_with_red_pictures
+from support.chromium import assert_pictures_drawn, shots_with_red_pictures
+from support.requirements import requires_program
 
 from drumflow.report.html import write_report
 
-pytestmark = [
-    pytest.mark.chromium,
-    pytest.mark.skipif(
-        CHROMIUM is None,
-        reason="chromium is not installed (apt-get install -y chromium); the browser check needs it",
-    ),
-]
+# Without Chromium: skipped on a workstation, failed under CI (support/requirements.py).
+pytestmark = [pytest.mark.chromium, requires_program("chromium")]
 
 
 def test_report_renders_in_chromium(tmp_path: Path, write_synthetic_run: Callable[..., Any]) -> None:

@@ -1,6 +1,7 @@
 """The spin limit of the DEM step (drumflow.dem.timestep): the stability of velocity Verlet with
 a half-step dashpot, and the rotational mode of a bed contact. LIGGGHTS itself:
-tests/solver/test_spin_liggghts.py."""
+tests/solver/test_spin_liggghts.py; the shipped spin studies' numbers (no code):
+tests/shipped/test_shipped_spin_studies.py."""
 
 from __future__ import annotations
 
@@ -158,68 +159,3 @@ def test_a_soft_shallow_bed_keeps_the_contact_step() -> None:
     auto = choose_time_step(stiff)
     assert auto.bound == "rayleigh"
     assert auto.time_step == pytest.approx(choose_time_step(_contact_step(stiff)).time_step)
-
-
-def test_the_shipped_study_shows_the_numerical_spin_and_its_cause() -> None:
-    """The README's table (model one from its 5.5 s restart, 100 steps of the default step's
-    time): the default step's rotational energy is ten times a resolved step's; half and a
-    quarter of the step agree (converged), and so does the default step without the tangential
-    dashpot (the cause). The long run at the default step keeps about 2 J from 0.25 s on."""
-    import pandas as pd
-
-    study = pd.read_csv(ROOT / "results" / "bench" / "paper_model_one_settings" / "spin_5.5s.csv")
-    row = study.set_index("variant")
-    spin, ke = row["rotational_kinetic_energy_J"], row["kinetic_energy_J"]
-    assert spin["baseline"] > 5.0 * spin["half_step"]
-    assert spin["half_step"] == pytest.approx(spin["quarter_step"], rel=0.02)
-    assert spin["no_tangential_damping"] == pytest.approx(spin["quarter_step"], rel=0.02)
-    assert ke["half_step"] == pytest.approx(ke["quarter_step"], rel=0.002)
-    assert ke["baseline"] > 1.015 * ke["quarter_step"]
-    energy = pd.read_csv(ROOT / "results" / "bench" / "paper_model_one_spin" / "long_run" / "energy.csv")
-    formed = energy[energy["time_s"] >= 0.25]
-    assert formed["rotational_kinetic_energy_J"].between(1.8, 2.7).all()
-
-
-def test_the_whole_run_study_shows_the_old_steps_bias_on_the_flow() -> None:
-    """results/bench/paper_model_two_spin (the README's table): over 17.5 s of model two's
-    parcels, the cascading bed's flow at the old step (1.61 x the spin limit) is above the half
-    step's by more than twice the half step's noise floor, in both runs at the old step, which
-    agree with each other within 1 %; the heat answers agree within 0.1 %."""
-    import json
-
-    spin = ROOT / "results" / "bench" / "paper_model_two_spin"
-    ladder = json.loads((spin / "ladder.json").read_text())
-    assert ladder["reference"] == "half_step"
-    rungs = {r["rung"]: r for r in ladder["rungs"]}
-    floor = ladder["noise_floor"]["steady_mass_flow"]
-    for name in ("default_step", "default_step_replicate"):
-        assert rungs[name]["error_steady_mass_flow"] > max(2.0 * floor, 0.04)
-        assert abs(rungs[name]["error_h"]) < 1e-3 and abs(rungs[name]["error_temperature"]) < 1e-3
-    old, replicate = (rungs[n]["value_steady_mass_flow"] for n in ("default_step", "default_step_replicate"))
-    assert abs(replicate / old - 1.0) < 0.01
-    steps = {n: json.loads((spin / n / "manifest.json").read_text())["time_step"]["time_step"]
-             for n in ("half_step", "default_step")}
-    assert steps["half_step"] == pytest.approx(0.5 * steps["default_step"], rel=1e-9)
-
-
-def test_the_fast_profile_run_lands_on_the_resolved_spins_answers() -> None:
-    """results/bench/paper_model_two_spin/fast (README, 'The fast profile'): without the
-    tangential dashpot, at the old (contact) step, the three answers over 17.5 s are within the
-    half step's noise floor and 1 % of it (the old step with the dashpot: +5.5 %), and the run
-    took the old step, the dashpot off and no conduction, as its manifest records."""
-    import json
-
-    spin = ROOT / "results" / "bench" / "paper_model_two_spin"
-    ladder = json.loads((spin / "ladder.json").read_text())
-    rungs = {r["rung"]: r for r in ladder["rungs"]}
-    floor = ladder["noise_floor"]["steady_mass_flow"]
-    fast = rungs["fast"]
-    assert abs(fast["error_steady_mass_flow"]) < min(floor, 0.01)
-    assert abs(fast["error_h"]) < 1e-3 and abs(fast["error_temperature"]) < 1e-3
-    assert fast["speedup"] > 1.3
-    manifest = json.loads((spin / "fast" / "manifest.json").read_text())
-    old = json.loads((spin / "default_step" / "manifest.json").read_text())
-    assert manifest["case"]["contacts"]["tangential_damping"] is False
-    assert manifest["case"]["run"]["conduction"] is False
-    assert manifest["time_step"]["time_step"] == pytest.approx(old["time_step"]["time_step"], rel=1e-9)
-    assert manifest["time_step"]["bound"] == "contact"

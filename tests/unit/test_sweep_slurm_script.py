@@ -4,11 +4,11 @@ stopped before its time limit (tests/solver/test_sweep_slurm.py runs them on a r
 from __future__ import annotations
 
 import json
-import shutil
 import subprocess
 from pathlib import Path
 
 import pytest
+from support.requirements import requires_program
 
 from drumflow.sweep.executor import Attempt
 from drumflow.sweep.slurm import SlurmExecutor
@@ -19,7 +19,7 @@ def _executor(root: Path, **settings: object) -> SlurmExecutor:
     return SlurmExecutor(root, SlurmSettings(**settings), Runs(processes=2), "demo", 3)  # type: ignore[arg-type]
 
 
-@pytest.mark.skipif(shutil.which("bash") is None, reason="no bash")
+@requires_program("bash")  # skipped without bash on a workstation, failed under CI
 def test_the_batch_script_is_valid_bash_and_traps_the_time_limit_warning(tmp_path: Path) -> None:
     script = _executor(tmp_path).script()
     check = subprocess.run(["bash", "-n"], input=script, text=True, capture_output=True, check=False)

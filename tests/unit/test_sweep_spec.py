@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import subprocess
 import sys
-import tomllib
 from pathlib import Path
 from typing import Any
 
@@ -134,11 +133,6 @@ def test_cli_refuses_a_bad_sweep_with_exit_2_and_no_traceback(tmp_path: Path) ->
     assert "member m001" in proc.stderr and "drum.rpm" in proc.stderr
     assert "Traceback" not in proc.stderr
     assert not (tmp_path / "out").exists()  # nothing written, nothing submitted
-
-
-def test_shipped_sweep_file_is_valid_toml_with_both_executors() -> None:
-    data = tomllib.loads((ROOT / "cases" / "sweep_smoke.toml").read_text())
-    assert data["executor"]["kind"] == "local" and "slurm" in data["executor"]
 
 
 @pytest.mark.parametrize(("limit", "seconds"), [("30", 1800), ("05:30", 330), ("02:00:00", 7200),

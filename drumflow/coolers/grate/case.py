@@ -22,9 +22,9 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import BaseModel, Field, model_validator
 
-from drumflow.case import read_toml, validate_model
+from drumflow.case import INPUT_MODEL_CONFIG, read_toml, validate_model
 from drumflow.coolers.grate.properties import AIR_T_MAX, AIR_T_MIN
 
 __all__ = [
@@ -33,9 +33,28 @@ __all__ = [
 ]
 
 
+#: Most balance cells (cells_length x cells_height) of one grid. Measured here (2 shared
+#: cores): a sweep costs about 0.65 us per cell on large grids, so one sweep of 1,000,000
+#: cells takes about 0.7 s and a converged solve (9 sweeps at under_relaxation = 1) about
+#: 10 s; the old maxima (4000 x 2000 = 8,000,000 cells) needed gigabytes and minutes per
+#: sweep. The report's grid is 120 x 90.
+MAX_CELLS = 1_000_000
+
+#: A line solve (one TDMA call and its set-up) costs about as much as this many cells:
+#: measured 90 us per line against 0.65 us per cell (4000 x 2 cells: 0.36 s per sweep).
+LINE_COST_CELLS = 140
+
+#: Most work a solve may do before it gives up: numerics.max_sweeps x (cells +
+#: LINE_COST_CELLS x lines), in cell-sweeps. 1e8 is about 65 s here (0.65 us each), the
+#: report's case at its 2000 sweeps (8.0e7) included; a solve that converges stops long
+#: before (9 sweeps at under_relaxation = 1, 90 at 0.5, 1,238 at 0.05 on the report's grid).
+MAX_SWEEP_WORK = 100_000_000
+
+
 class _Section(BaseModel):
     # Unknown keys are errors: a misspelt field must not fall back to a default silently.
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    # The one input-model config (strict types, finite numbers): drumflow.case.
+    model_config = INPUT_MODEL_CONFIG
 
 
 class Cooler(_Section):
@@ -144,6 +163,7 @@ class GrateCase(_Section):
                 problems.append(
                     f"clinker.{field}_slope = {slope}: makes clinker.{field} {low_end:.4g} <= 0 "
                     f"between {lo:g} K and {hi:g} K; allowed: positive over that range")
+        problems += _size_problems(self.numerics)
         if problems:
             raise ValueError("\n".join(problems))
         return self
@@ -154,6 +174,23 @@ class GrateCase(_Section):
         c = self.clinker
         return c.mass_flow / (c.density * (1.0 - c.bed_porosity) * self.cooler.grate_speed
                               * self.cooler.width)
+
+
+def _size_problems(num: Numerics) -> list[str]:
+    """The grid and the sweep limit against what finishes here (MAX_CELLS, MAX_SWEEP_WORK)."""
+    n, m = num.cells_length, num.cells_height
+    cells = n * m
+    if cells > MAX_CELLS:
+        return [f"numerics.cells_length = {n:,} x numerics.cells_height = {m:,}: {cells:,} cells; "
+                f"allowed up to {MAX_CELLS:,} (fewer cells along or across the bed)"]
+    per_sweep = cells + LINE_COST_CELLS * (n + m)
+    work = num.max_sweeps * per_sweep
+    if work > MAX_SWEEP_WORK:
+        return [f"numerics.max_sweeps = {num.max_sweeps:,} x ({cells:,} cells + "
+                f"{LINE_COST_CELLS} x {n + m:,} lines) = {work:,} cell-sweeps; allowed up to "
+                f"{MAX_SWEEP_WORK:,} (numerics.max_sweeps up to "
+                f"{MAX_SWEEP_WORK // per_sweep:,} on this grid, or fewer cells)"]
+    return []
 
 
 def grate_case_from_dict(data: dict[str, Any], source: Path | str | None = None) -> GrateCase:

@@ -8,6 +8,7 @@ field's range is reported with the field's name and range before anything runs.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -27,6 +28,7 @@ __all__ = [
     "parse_vary",
     "resolve_field",
     "run_sweep",
+    "vary_cases",
 ]
 
 #: Short names of the fields most studies vary, and their case paths.
@@ -44,6 +46,12 @@ ALIASES: dict[str, str] = {
 }
 
 _MAX_POINTS = 200
+
+#: Most balance cells a --vary study may solve in all (the sum over its cases). A converged
+#: solve costs about 9 sweeps at 0.65-2 us per cell and sweep here (2 shared cores), so
+#: 10,000,000 cells take about a minute: the report's 120 x 90 grid at the 200 points --vary
+#: allows (2,160,000 cells) passes; 200 points of a 1,000,000-cell grid (hours) do not.
+MAX_STUDY_CELLS = 10_000_000
 
 
 def resolve_field(name: str) -> str:
@@ -90,6 +98,11 @@ def parse_vary(text: str) -> tuple[str, list[float]]:
     except ValueError:
         raise CaseError([f"--vary {text!r}: expected {form}"]) from None
     if ":" in spec:
+        values = [start, stop]
+    if not all(math.isfinite(v) for v in values):
+        # float() reads "inf" and "nan"; no field means them (and int(round(inf)) would crash).
+        raise CaseError([f"--vary {text!r}: not a finite number; allowed: finite numbers"])
+    if ":" in spec:
         if not 2 <= count <= _MAX_POINTS:
             raise CaseError([f"--vary {text!r}: COUNT = {count}; allowed: 2 to {_MAX_POINTS}"])
         # Rounded to 12 digits so 0.05:0.2:4 gives 0.15, not 0.15000000000000002.
@@ -107,6 +120,24 @@ def case_with(case: GrateCase, path: str, value: float) -> GrateCase:
     current = data[section][name]
     data[section][name] = int(round(value)) if isinstance(current, int) else value
     return grate_case_from_dict(data, f"{case.name} with {path} = {value:g}")
+
+
+def vary_cases(case: GrateCase, path: str, values: Sequence[float]) -> list[GrateCase]:
+    """The cases of a --vary study, each validated, and their total size bounded.
+
+    Raises
+    ------
+    CaseError
+        A varied value is outside its field's range, or the study would solve more than
+        :data:`MAX_STUDY_CELLS` cells.
+    """
+    cases = [case_with(case, path, v) for v in values]
+    cells = sum(c.numerics.cells_length * c.numerics.cells_height for c in cases)
+    if cells > MAX_STUDY_CELLS:
+        raise CaseError([f"--vary {path}: {len(cases)} values x the cases' cells "
+                         f"(numerics.cells_length x numerics.cells_height) = {cells:,} cells; "
+                         f"allowed up to {MAX_STUDY_CELLS:,} (fewer values or a coarser grid)"])
+    return cases
 
 
 @dataclass(frozen=True)
@@ -140,7 +171,7 @@ def run_sweep(case: GrateCase, path: str, values: Sequence[float],
               progress: Callable[[int, int], None] | None = None) -> Sweep:
     """Solve the case once per value of one field (all cases validated before the first
     solve)."""
-    cases = [case_with(case, path, v) for v in values]
+    cases = vary_cases(case, path, values)
     solutions = []
     for k, c in enumerate(cases):
         solutions.append(solve_grate(c))

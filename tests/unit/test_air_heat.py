@@ -1,0 +1,84 @@
+"""The air's temperature on the field's grid (``drumflow.air.heat``): conservation, the mixed
+outlet of plug flow, the projection of a field that is not divergence-free, the implicit
+particle coupling against the explicit source, and the cells of points beside walls."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from drumflow.air.field import AirField
+from drumflow.air.heat import AirHeat, coarse_field
+
+RHO, CP = 1.16, 1007.0
+
+
+def _duct(shape: tuple[int, int, int] = (5, 5, 41), speed: float = 2.0,
+          noise: float = 0.0, blocked: bool = False) -> AirField:
+    velocity = np.zeros((*shape, 3))
+    velocity[..., 2] = -speed
+    if noise:
+        velocity += np.random.default_rng(1).normal(0.0, noise, velocity.shape)
+    fluid = np.ones(shape, dtype=bool)
+    if blocked:
+        fluid[2, 2, 10:20] = False  # a lifter-like obstacle
+    return AirField(origin=np.zeros(3), spacing=np.array([0.01, 0.01, 0.005]), velocity=velocity,
+                    pressure=np.zeros(shape), fluid=fluid, omega=0.0)
+
+
+def test_plug_flow_outlet_is_the_mixed_temperature() -> None:
+    """One source anywhere: the outlet's flow-weighted mean is T_in + Q / (rho c_p V)."""
+    heat = AirHeat(_duct(), 30.0, RHO, CP)
+    source = np.zeros(heat.cells)
+    source[heat.cells_of(np.array([[0.02, 0.02, 0.1]]))] = 100.0
+    temperature = heat.solve(source)
+    assert heat.volume_flow == pytest.approx(5 * 5 * 1e-4 * 2.0)
+    assert heat.outlet_temperature(temperature) == pytest.approx(30.0 + 100.0 / (RHO * CP * heat.volume_flow),
+                                                                 rel=1e-10)
+    # Upstream of the source the air is still at the inlet temperature.
+    assert temperature[heat.cells_of(np.array([[0.02, 0.02, 0.19]]))][0] == pytest.approx(30.0, abs=1e-6)
+
+
+def test_enthalpy_is_conserved_on_a_field_that_is_not_divergence_free() -> None:
+    """Random velocities and an obstacle: the projection leaves no net flow in any cell, so the
+    air carries out exactly the heat it was given."""
+    heat = AirHeat(_duct(noise=0.3, blocked=True), 30.0, RHO, CP)
+    source = np.random.default_rng(2).uniform(0.0, 10.0, heat.cells)
+    gain = heat.enthalpy_gain(heat.solve(source))
+    assert gain == pytest.approx(source.sum(), rel=1e-9)
+
+
+def test_implicit_particles_give_the_same_field_as_their_heat_as_a_source() -> None:
+    heat = AirHeat(_duct(), 30.0, RHO, CP)
+    cells = heat.cells_of(np.array([[0.02, 0.02, 0.1], [0.02, 0.02, 0.15], [0.0, 0.04, 0.05]]))
+    g = np.zeros(heat.cells)
+    gt = np.zeros(heat.cells)
+    np.add.at(g, cells, 0.5)
+    np.add.at(gt, cells, 0.5 * 90.0)
+    implicit = heat.solve_with_particles(g, gt)
+    source = np.zeros(heat.cells)
+    np.add.at(source, cells, 0.5 * (90.0 - implicit[cells]))
+    np.testing.assert_allclose(heat.solve(source), implicit, atol=1e-8)
+    # A particle never heats its air past itself, however strong its film.
+    strong = heat.solve_with_particles(g * 1e4, gt * 1e4)
+    assert strong.max() <= 90.0 + 1e-6
+
+
+def test_points_in_walls_go_to_the_nearest_fluid_cell() -> None:
+    field = _duct(blocked=True)
+    heat = AirHeat(field, 30.0, RHO, CP)
+    inside_obstacle = np.array([[0.02, 0.02, 0.07]])  # node (2, 2, 14) is not fluid
+    cell = heat.cells_of(inside_obstacle)[0]
+    xyz = heat.nodes_xyz()[cell]
+    # The obstacle runs 10 nodes (0.05 m) along z: the nearest air is one node across (0.01 m).
+    assert np.linalg.norm(xyz - inside_obstacle[0]) == pytest.approx(0.01, rel=1e-9)
+
+
+def test_coarse_field_keeps_the_box_and_the_flow() -> None:
+    field = _duct(shape=(9, 9, 41))
+    coarse = coarse_field(field, 0.02)
+    assert coarse.shape == (5, 5, 11)
+    np.testing.assert_allclose(coarse.velocity[..., 2], -2.0)
+    hi = field.origin + field.spacing * (np.array(field.shape) - 1)
+    np.testing.assert_allclose(coarse.origin + coarse.spacing * (np.array(coarse.shape) - 1), hi)
+    assert coarse_field(field, 0.001) is field  # never finer than the field
