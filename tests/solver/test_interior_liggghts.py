@@ -57,11 +57,14 @@ def test_tiny_drum_with_shells_resumes_with_its_profiles_and_closes_energy(tmp_p
     from drumflow.pipeline import run_case
     from drumflow.verify.scenes import tiny_drum
 
-    case = tiny_drum(air__model="uniform", air__mass_flow=0.1, run__time=1.0,
+    # 2 s of the tiny drum take about 36 s here when the machine is idle: the 12 s limit
+    # interrupts it a third of the way, and a machine 4 times as busy still passes three of the
+    # restarts every 0.05 s (regression: 1 s with a 40 s limit finished before the limit, idle).
+    case = tiny_drum(air__model="uniform", air__mass_flow=0.1, run__time=2.0,
                      run__restart_interval=0.05, run__processes=2, particles__interior="shells")
     out = tmp_path / "run"
     with pytest.raises(SolverTimeoutError):
-        run_case(case, out, timeout=40)
+        run_case(case, out, timeout=12)
     summary = run_case(case, out, timeout=600)
     assert json.loads((out / "stages" / "dem.json").read_text())["result"]["resumed_from_step"]
     assert summary["energy_balance_error"] < 1e-6
