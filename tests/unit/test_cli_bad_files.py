@@ -253,11 +253,8 @@ ROWS: list[tuple[str, Setup, list[str]]] = [
 ]
 
 
-@pytest.mark.parametrize(("build", "named"), [pytest.param(b, n, id=i) for i, b, n in ROWS])
-def test_a_damaged_file_exits_2_naming_it_without_traceback(
-    tmp_path: Path, build: Setup, named: list[str]
-) -> None:
-    args = build(tmp_path)
+def assert_refused(args: list[str], named: list[str]) -> None:
+    """The command exits 2 without a traceback, its message naming every piece of ``named``."""
     out = _drumflow(*args)
     text = out.stdout + out.stderr
     assert out.returncode == 2, text
@@ -265,6 +262,13 @@ def test_a_damaged_file_exits_2_naming_it_without_traceback(
     flat = _flat(text)
     for piece in named:
         assert piece in flat, (piece, text)
+
+
+@pytest.mark.parametrize(("build", "named"), [pytest.param(b, n, id=i) for i, b, n in ROWS])
+def test_a_damaged_file_exits_2_naming_it_without_traceback(
+    tmp_path: Path, build: Setup, named: list[str]
+) -> None:
+    assert_refused(build(tmp_path), named)
     # Nothing was written for a refused command.
     assert not (tmp_path / "out" / "paper.html").exists()
     assert not (tmp_path / "r.html").exists()
