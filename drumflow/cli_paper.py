@@ -25,6 +25,7 @@ from rich.table import Table
 from drumflow.cli_guard import cli_console
 from drumflow.cli_progress import StageProgress, resume_hint
 from drumflow.errors import CaseError, DrumflowError
+from drumflow.readers import read_json_object
 
 console = cli_console()
 err_console = cli_console(stderr=True)
@@ -51,10 +52,9 @@ def _finished(run_dir: Path, case_hash: str) -> bool:
     summary = run_dir / "summary.json"
     if not ((run_dir / "stages" / "dem.json").is_file() and summary.is_file()):
         return False
-    try:
-        return bool(json.loads(summary.read_text()).get("case_hash") == case_hash)
-    except ValueError:
-        return False
+    # A damaged summary is refused by name (BadFileError), not taken for an unfinished run:
+    # rerunning would replace what only the finished run knows.
+    return bool(read_json_object(summary, "the run's summary").get("case_hash") == case_hash)
 
 
 def _run_model(case_file: Path, out: Path, processes: int | None) -> None:

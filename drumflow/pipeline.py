@@ -6,7 +6,6 @@
 
 from __future__ import annotations
 
-import json
 import math
 import os
 import socket
@@ -44,7 +43,7 @@ from drumflow.dem.stage import (
 )
 from drumflow.dem.thermo import read_thermo
 from drumflow.dem.timestep import TimeStepChoice, choose_time_step
-from drumflow.errors import CaseError, RunDirectoryError
+from drumflow.errors import BadFileError, CaseError, RunDirectoryError
 from drumflow.readers import read_csv, read_json_object
 from drumflow.report.plots import (
     plot_air_heat,
@@ -297,6 +296,7 @@ def post_run(out: Path | str, case: Case | None = None) -> dict[str, Any]:
                    time_s=float(snaps.times[-1]))
 
     air_info = _post_air(rundir, case, float(ts), times, T_mean)
+    closures_info = _post_closures(rundir)
 
     final = int(thermo["atoms"].iloc[-1])
     problems = []
@@ -325,6 +325,7 @@ def post_run(out: Path | str, case: Case | None = None) -> dict[str, Any]:
         "output_steps": int(len(times)),
         "snapshots": int(len(snaps.times)),
         **air_info,
+        **closures_info,
         **_stop_info(rundir),
         "post_read_s": read_s,
         "post_wall_time_s": time.perf_counter() - t0,
@@ -338,12 +339,28 @@ def post_run(out: Path | str, case: Case | None = None) -> dict[str, Any]:
     return merged
 
 
+def _post_closures(rundir: RunDir) -> dict[str, Any]:
+    """``post/closures.json``: what the whole-cooler model needs from the slice, measured from
+    the snapshots now, because shipped results keep the closures but not the snapshots. A run
+    that has none to give (no snapshot after ``run.mass_flow_start``, nothing airborne) says
+    why in the summary instead."""
+    from drumflow.analysis.closures import extract_closures
+
+    rundir.closures_json.unlink(missing_ok=True)  # never a stale file beside new series
+    try:
+        closures = extract_closures(rundir.root)
+    except (RunDirectoryError, BadFileError) as exc:
+        return {"closures_not_measured": str(exc).splitlines()[0]}
+    write_json_atomic(rundir.closures_json, closures.to_dict())
+    return {"closures_file": "post/closures.json"}
+
+
 def _stop_info(rundir: RunDir) -> dict[str, Any]:
     """Why and when a 'converged' run stopped, with its intervals (nothing for a fixed run)."""
     path = rundir.dem / STOP_RECORD
     if not path.exists():
         return {}
-    return {"stop": json.loads(path.read_text())}
+    return {"stop": read_json_object(path, "the stop rule's record")}
 
 
 def _post_air(

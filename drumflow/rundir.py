@@ -247,6 +247,12 @@ class RunDir:
         return self.post / "crossings.csv"
 
     @property
+    def closures_json(self) -> Path:
+        """``post/closures.json``: the slice closures ``drumflow post`` measured from the
+        snapshots; shipped results keep it where they keep no snapshots."""
+        return self.post / "closures.json"
+
+    @property
     def crossings_table(self) -> Path:
         """The crossing table to read: ``post/crossings.csv``, or the gzipped copy a shipped
         results folder holds when the table is large (``post/crossings.csv.gz``)."""

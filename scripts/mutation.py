@@ -55,6 +55,9 @@ MODULES: dict[str, tuple[str, list[str]]] = {
                            "tests/unit/test_shell_batch.py"]),
 }
 
+#: Shipped results the selected tests read (the rest of results/ is not copied).
+RESULTS_READ = ("results/paper/model_one/post/closures.json",)
+
 #: mutmut 3 exit codes of a mutant's test run (mutmut/__main__.py, status_by_exit_code).
 KILLED, SURVIVED = {1, 3}, {0}
 
@@ -66,7 +69,8 @@ def _copy_tree(scratch: Path) -> None:
         shutil.rmtree(scratch)
     for name in filter(None, files):
         src = ROOT / name
-        if src.is_file() and not name.startswith((".venv/", "results/", "runs/")):
+        if src.is_file() and (name in RESULTS_READ
+                              or not name.startswith((".venv/", "results/", "runs/"))):
             dst = scratch / name
             dst.parent.mkdir(parents=True, exist_ok=True)
             shutil.copy2(src, dst)
@@ -79,7 +83,9 @@ def _configure(scratch: Path, names: list[str]) -> None:
              "only_mutate = " + json.dumps(sources),
              "pytest_add_cli_args_test_selection = " + json.dumps(tests),
              'pytest_add_cli_args = ["-p", "no:cacheprovider", "-x", "-q"]',
-             'also_copy = ["cases"]',
+             # Folders (mutmut copies a file only where its folder exists): the scratch copy
+             # holds nothing else of results/.
+             "also_copy = " + json.dumps(["cases", *sorted({str(Path(f).parent) for f in RESULTS_READ})]),
              "use_git_change_detection = false", ""]
     with (scratch / "pyproject.toml").open("a") as fh:
         fh.write("\n".join(block))

@@ -31,6 +31,7 @@ from typing import TYPE_CHECKING, Any
 from drumflow.air.source import FieldSource, mean_axial_velocity, uniform_field
 from drumflow.air_properties import ideal_gas_density
 from drumflow.geometry.lifters import free_area
+from drumflow.readers import read_json_object
 
 if TYPE_CHECKING:
     from drumflow.case import Case
@@ -158,7 +159,9 @@ def _run_cfd(case: Case, rundir: RunDir, runner: Runner, inputs: AirInputs) -> A
     t0 = time.perf_counter()
     if not hit:
         _solve_into_cache(case, rundir, runner, inputs, cache)
-    info = json.loads((cache / "solution.json").read_text())
+    # A cache entry cut short (a killed writer) is refused by name: delete it to solve again.
+    info = read_json_object(cache / "solution.json",
+                            "the air field cache's record (delete its folder to solve again)")
     rundir.air.mkdir(parents=True, exist_ok=True)
     shutil.copyfile(cache / "field.npz", rundir.air_field)
     rundir.air_solution.write_text(json.dumps(info, indent=2))

@@ -91,6 +91,9 @@ class SliceClosures:
         Snapshots averaged.
     window_s
         Time window of the snapshots and crossings used.
+    start_s
+        The simulated time from which they were measured (``--start``, or the case's
+        ``run.mass_flow_start``); None in files written before it was recorded.
     """
 
     source: str
@@ -116,6 +119,7 @@ class SliceClosures:
     bed_surface_m2_per_m: float
     snapshots: int
     window_s: tuple[float, float]
+    start_s: float | None = None
 
     @property
     def froude(self) -> float:
@@ -139,10 +143,10 @@ class SliceClosures:
     def from_dict(cls, data: dict[str, Any]) -> SliceClosures:
         """Inverse of :meth:`to_dict` (derived entries are ignored)."""
         names = {f for f in cls.__dataclass_fields__}
-        missing = sorted(names - set(data))
+        missing = sorted(names - set(data) - {"start_s"})
         if missing:
             raise RunDirectoryError(f"closures: missing field(s) {', '.join(missing)}")
-        values = {k: data[k] for k in names}
+        values = {k: data[k] for k in names if k in data}
         values["window_s"] = tuple(values["window_s"])
         return cls(**values)
 
@@ -193,6 +197,7 @@ class ClosuresFile(BaseModel):
     bed_surface_m2_per_m: float = _NonNegative
     snapshots: int = Field(ge=1)
     window_s: list[float] = Field(min_length=2, max_length=2)
+    start_s: float | None = Field(default=None, ge=0, allow_inf_nan=False)
 
     @field_validator("window_s")
     @classmethod
@@ -316,17 +321,18 @@ def extract_closures(run_dir: Path | str, start_s: float | None = None) -> Slice
             raise RunDirectoryError(f"{f}: missing ({what}); run `drumflow run CASE --out "
                                     f"{root}` (or `drumflow post {root}`) first")
     snaps = [f for f in dump_files(run.dem_dumps, "snap")]
-    if not snaps:
-        # Checked before the crossing table is read (seconds for a paper run): shipped results
-        # keep no snapshots, and the airborne share, speeds and bed surface need them.
-        raise RunDirectoryError(
-            f"{run.dem_dumps}: no particle snapshot (snap.*.txt or .npz); the closures need the "
-            "run's snapshots (shipped results do not keep them): give the run directory itself, "
-            "or a closures JSON file saved from it with --save-closures")
     case = load_case(case_file)
     start = case.run.mass_flow_start if start_s is None else float(start_s)
+    if not snaps:
+        # Checked before the crossing table is read (seconds for a paper run): shipped results
+        # keep no snapshots, and the airborne share, speeds and bed surface need them; they keep
+        # the closures `drumflow post` measured from them instead.
+        return _recorded_closures(run, start_s)
     length = case.drum.length
-    mass = case.particles.mass
+    # What the DEM moved: under coarse-graining each crossing and each snapshot row is a parcel
+    # of k**3 particles (counted with the particles' mass, the flow came out k**3 too small).
+    parcels = case.dem_case()
+    mass = parcels.particles.mass
     crossings = read_csv(crossings_file, "the crossing table", columns=("time", "id", "x", "z"),
                          finite=("time", "x", "z"))
     flow = falling_mass_flow(crossings, mass, start=start)
@@ -367,7 +373,7 @@ def extract_closures(run_dir: Path | str, start_s: float | None = None) -> Slice
             slips.append(float(slip[falling].mean()))
         bed_slips.append(float(slip[~falling].mean()) if (~falling).any() else math.nan)
         beds.append(bed_surface_length(c["x"][~falling], c["y"][~falling], case.drum.radius,
-                                       2.0 * case.particles.diameter, case.lifters.base_height))
+                                       2.0 * parcels.particles.diameter, case.lifters.base_height))
         times.append(t)
     if not times:
         raise RunDirectoryError(f"{root / 'dem' / 'dumps'}: no snapshot after {start:g} s")
@@ -401,6 +407,7 @@ def extract_closures(run_dir: Path | str, start_s: float | None = None) -> Slice
         bed_surface_m2_per_m=float(np.mean(beds)),
         snapshots=len(times),
         window_s=(float(min(times[0], flow.window_start_s)), float(max(times[-1], flow.window_end_s))),
+        start_s=start,
     )
     # The same check as a closures file's: a NaN (no airborne particle in any snapshot) would
     # otherwise stop the drum model far from its cause, or be saved with --save-closures.
@@ -412,4 +419,24 @@ def extract_closures(run_dir: Path | str, start_s: float | None = None) -> Slice
         raise RunDirectoryError(
             f"{run.dem_dumps}: the closures of its {len(times)} snapshot(s) after {start:g} s are "
             f"not usable (a NaN: no airborne particle in any of them?):\n{lines}") from None
+    return closures
+
+
+def _recorded_closures(run: RunDir, start_s: float | None) -> SliceClosures:
+    """The closures ``drumflow post`` recorded (``post/closures.json``) of a run directory
+    without snapshots (shipped results), if they were measured from the time asked for."""
+    path = run.closures_json
+    if not path.is_file():
+        raise RunDirectoryError(
+            f"{run.dem_dumps}: no particle snapshot (snap.*.txt or .npz) and no {path.name} in "
+            f"{run.post}: the closures need the run's snapshots (shipped results keep the "
+            "closures `drumflow post` measured instead): give the run directory itself, or a "
+            "closures JSON file saved from it with --save-closures")
+    closures = load_closures(path)
+    if start_s is not None and (closures.start_s is None or abs(closures.start_s - start_s) > 1e-9):
+        recorded = "an unrecorded time" if closures.start_s is None else f"{closures.start_s:g} s"
+        raise RunDirectoryError(
+            f"--start = {start_s:g} s: {run.root} keeps no snapshots, only the closures in "
+            f"{path} measured from {recorded}; leave --start out to use them, or give the run "
+            "directory with its snapshots")
     return closures

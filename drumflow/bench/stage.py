@@ -45,6 +45,7 @@ from drumflow.bench.ladder import (
 )
 from drumflow.bench.pareto import pareto_front, plot_pareto
 from drumflow.errors import CaseError, DrumflowError
+from drumflow.readers import read_json_object
 from drumflow.rundir import RunDir
 from drumflow.runner import Runner
 
@@ -228,7 +229,7 @@ def run(case: Case, rundir: RunDir, runner: Runner, inputs: BenchInputs) -> Benc
                 continue
             base_case = base[0]
             hand = _by_hand(run, base[1], runner.profile.processes_for(base_case), runner)
-            summary = json.loads(RunDir(base[1], create=False).summary_path.read_text())
+            summary = read_json_object(RunDir(base[1], create=False).summary_path, "the base rung's summary")
             summary = {**summary, **hand}
             row = _row(rung, base_case, summary, base[1], "ok", case.run.time)
         else:

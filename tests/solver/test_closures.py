@@ -88,3 +88,46 @@ def test_plant_closures_from_a_later_start(tiny_run: Path, tmp_path: Path) -> No
     first = json.loads(out.stdout)
     second = json.loads(again.stdout)
     assert second["material_outlet_temperature_C"] == first["material_outlet_temperature_C"]
+
+
+@pytest.mark.timeout(300)
+def test_post_records_the_closures_and_shipped_results_use_them(tiny_run: Path, tmp_path: Path) -> None:
+    """`drumflow post` writes post/closures.json; a copy of the run without its snapshots (as
+    results are shipped) gives the same closures from it, and refuses another --start by name."""
+    import shutil
+
+    from drumflow.case import load_case
+    from drumflow.errors import RunDirectoryError
+
+    recorded = load_closures(tiny_run / "post" / "closures.json")
+    assert recorded == extract_closures(tiny_run)
+    start = load_case(tiny_run / "case.toml").run.mass_flow_start
+    assert recorded.start_s == pytest.approx(start)
+    shipped = tmp_path / "shipped"
+    shutil.copytree(tiny_run, shipped, ignore=shutil.ignore_patterns("dumps", "restart"))
+    assert extract_closures(shipped) == recorded
+    with pytest.raises(RunDirectoryError, match=rf"--start = 1\.5 s.*measured from {start:g} s"):
+        extract_closures(shipped, start_s=1.5)
+    (shipped / "post" / "closures.json").unlink()
+    with pytest.raises(RunDirectoryError, match="no particle snapshot .* and no closures.json"):
+        extract_closures(shipped)
+
+
+@pytest.mark.timeout(600)
+def test_closures_of_a_coarse_grained_run_count_parcels(tmp_path: Path) -> None:
+    """Regression: with particles.coarse_grain = k each crossing is a parcel of k**3 particles;
+    the closures counted it with one particle's mass, so G_f came out k**3 times too small
+    (12.8 against 102.3 kg/(s m) on model two's parcels of k = 2; 3.4 times here, k = 1.5)."""
+    case = case_from_dict(tiny_case_dict(
+        air__model="uniform", air__mass_flow=0.06, run__time=2.0, run__snapshot_interval=0.25,
+        particles__coarse_grain=1.5))  # the largest parcels the tiny drum's lifters pass
+    out = tmp_path / "run"
+    run_case(case, out, timeout=400)
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["falling_mass_flow_kg_s"] > 0
+    c = extract_closures(out)
+    # post counts the parcels with their own mass (case.dem_case()): the same flow per metre.
+    assert c.falling_mass_flow_kg_s_m == pytest.approx(
+        summary["falling_mass_flow_kg_s"] / c.section_length_m, rel=1e-5)
+    # The granule stays the real one (the heat-transfer closures need its diameter).
+    assert c.particle_diameter_m == pytest.approx(case.particles.diameter)

@@ -358,3 +358,19 @@ def test_a_gzipped_crossing_table_still_reads(tmp_path: Path) -> None:
     with gzip.open(table, "wb") as fh:
         fh.write(b"time,id,x,z\n1.0,1,0.1,0.2\n")
     assert len(read_csv(table, columns=("time",), finite=("time",))) == 1
+
+
+def test_a_damaged_summary_of_a_finished_paper_run_is_refused(tmp_path: Path) -> None:
+    """Regression: `drumflow paper` took a run whose summary.json was cut short for an
+    unfinished one and ran the model again over it, without a word."""
+    from drumflow.cli_paper import _finished
+
+    run = tmp_path / "model_two"
+    (run / "stages").mkdir(parents=True)
+    (run / "stages" / "dem.json").write_text("{}")
+    summary = run / "summary.json"
+    summary.write_text(json.dumps({"case_hash": "abc", "simulated_time_s": 17.5}))
+    assert _finished(run, "abc") and not _finished(run, "other")
+    _cut(summary, 0.5)
+    with pytest.raises(BadFileError, match="summary.json.*cut short"):
+        _finished(run, "abc")

@@ -104,7 +104,7 @@ def test_bad_input_names_the_field() -> None:
 
 
 def test_the_plants_own_slice_needs_no_scaling() -> None:
-    """docs/plant/paper_model_one_closures.json: the closures of paper model one, a 0.1 m slice of
+    """results/paper/model_one/post/closures.json: the closures of paper model one, a 0.1 m slice of
     the plant itself (README, 'The plant's own slice'). Its drum is the plant's, and its hold-up
     per metre, set from the paper's particle count, is the one the plant's measured residence
     time gives (feed x 30 min / 19 m): two independent routes to one number. So the drum model
@@ -113,7 +113,8 @@ def test_the_plants_own_slice_needs_no_scaling() -> None:
 
     from drumflow.analysis.closures import load_closures
 
-    shipped = Path(__file__).resolve().parents[2] / "docs" / "plant" / "paper_model_one_closures.json"
+    shipped = Path(__file__).resolve().parents[2] / "results" / "paper" / "model_one"
+    shipped = shipped / "post" / "closures.json"
     closures = load_closures(shipped)
     assert closures.case_name == "paper_model_one"
     assert (closures.drum_diameter_m, closures.rpm, closures.tilt_deg) == (
