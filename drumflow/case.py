@@ -60,6 +60,12 @@ class Drum(_Section):
     facet_size: Positive | Literal["auto"] = Field(
         "auto", description="STL facet edge length, m; 'auto' picks it from drum and particle size"
     )
+    ends: Literal["fixed", "rotating", "periodic"] = Field(
+        "fixed", description="how the section ends along the axis: 'fixed', two flat planes that "
+        "stand still while the shell turns (the paper's closed slice; default); 'rotating', two "
+        "end plates that turn with the shell, as a real drum's end walls do; 'periodic', no end "
+        "plates, a particle leaving one end comes back at the other (the middle of a long drum)"
+    )
 
     @property
     def radius(self) -> float:
@@ -451,6 +457,14 @@ class Case(_Section):
                 f"run.mass_flow_start ({self.run.mass_flow_start} s) and at most run.time "
                 f"({self.run.time} s)"
             )
+        if self.drum.ends == "periodic" and self.air.model != "none":
+            # Not checked: the air enters and leaves through the section's end faces while the
+            # particles wrap around them, and the coupling loop was not run against it.
+            problems.append(
+                f"drum.ends = 'periodic': not with air.model = '{self.air.model}' (the air's "
+                "inlet and outlet are the end faces the particles would wrap through); allowed "
+                "with air.model = 'none', or drum.ends = 'fixed' or 'rotating'"
+            )
         size = self.air.mesh_size
         if size != "auto" and size > self.drum.diameter:
             # A cell larger than the drum cannot resolve it (gmsh would make a handful of
@@ -545,8 +559,15 @@ class Case(_Section):
         return hashlib.sha256(self.canonical_json().encode()).hexdigest()
 
     def section_hash(self, *sections: str) -> str:
-        """Hash of some sections only, e.g. ``("drum", "lifters")`` for the geometry cache."""
+        """Hash of some sections only, e.g. ``("drum", "lifters")`` for the geometry cache.
+
+        Options of :data:`_ADDED_AFTER_SECTION_HASHES` at their old value are left out, so
+        that a geometry cache or a start state made before the option existed keeps its hash.
+        """
         data = self.model_dump(mode="json")
+        for section, name, old_behaviour in _ADDED_AFTER_SECTION_HASHES:
+            if section in sections and data[section].get(name) == old_behaviour:
+                del data[section][name]
         sub = {s: data[s] for s in sections}
         return hashlib.sha256(json.dumps(sub, sort_keys=True).encode()).hexdigest()
 
@@ -564,6 +585,14 @@ _ADDED_LATER: tuple[tuple[str, str, object], ...] = (
     ("particles", "interior_shells", None),
     ("air", "warming", False),
     ("run", "start_state", None),
+    ("drum", "ends", "fixed"),
+)
+
+#: The options of :data:`_ADDED_LATER` that came after section hashes (geometry cache, start
+#: states) were first stored: :meth:`Case.section_hash` leaves them out at their old value. The
+#: earlier ones were always part of those hashes, so leaving them out would change them.
+_ADDED_AFTER_SECTION_HASHES: tuple[tuple[str, str, object], ...] = (
+    ("drum", "ends", "fixed"),
 )
 
 

@@ -505,6 +505,56 @@ def verify(
 
 
 @app.command()
+def validate(
+    name: Annotated[str | None, typer.Argument(help="scene to run (see --list)")] = None,
+    list_only: Annotated[bool, typer.Option("--list", help="name each scene, its source and what "
+                                            "it measures, and exit")] = False,
+    out: Annotated[
+        Path, typer.Option("--out", "-o", help="where the runs, validation.json, CSVs and plots go")
+    ] = Path("runs/validate"),
+    scale: Annotated[
+        str | None, typer.Option("--scale", help="small (minutes, a check of the chain), section "
+                                 "(periodic section, the comparison) or full (the whole drum)")
+    ] = None,
+    timeout: Annotated[float | None, typer.Option("--timeout", min=1, help="solver time limit, s")] = None,
+) -> None:
+    """Compare with experiments: run a validation scene and write validation.json, a CSV and a plot."""
+    from drumflow.readers import output_folder
+    from drumflow.validate import SCENES
+
+    if list_only or name is None:
+        for sc in SCENES.values():
+            console.print(f"[bold]{sc.name}[/]: {escape(sc.title)}", highlight=False)
+            console.print(f"  source: {escape(sc.source)}", highlight=False)
+            for m in sc.measures:
+                console.print(f"  measures: {escape(m)}", highlight=False)
+            console.print(f"  scales: {', '.join(sc.scales)} (default {sc.scales[0]})", highlight=False)
+        if name is None and not list_only:
+            raise typer.BadParameter("give a scene name, or --list", param_hint="NAME")
+        return
+    from drumflow.validate.run import run_validation
+
+    output_folder(out)
+    with StageProgress(err_console) as progress:
+        record = run_validation(name, out, scale, timeout=timeout, progress=progress)
+    table = Table(title=f"drumflow validate {name} ({record['scale']})")
+    for col in ("observable", "simulated", "measured", "error", "band", ""):
+        table.add_column(col, justify="right" if col not in ("observable", "") else "left")
+    for key, m in record["comparison"].items():
+        def num(v: Any) -> str:
+            return "n/a" if v is None else f"{v:.4g}"
+        err = m["error"]
+        err_text = "n/a" if err is None else (f"{100 * err:+.1f} %" if m["error_kind"] == "relative"
+                                              else f"{1e3 * err:+.1f} mm")
+        band = f"{100 * m['band']:g} %" if m["error_kind"] == "relative" else f"{1e3 * m['band']:g} mm"
+        table.add_row(key, num(m["simulated"]), num(m["measured"]), err_text, band,
+                      "[green]within[/]" if m["within_band"] else "[bold red]outside[/]")
+    console.print(table)
+    console.print(f"written: {out / 'validation.json'}, {out / record['csv']}, {out / record['plot']}",
+                  highlight=False)
+
+
+@app.command()
 def bench(
     case_file: Annotated[Path, typer.Argument(help="reference scene: a case file (TOML)")],
     out: Annotated[Path | None, typer.Option("--out", "-o", help="bench directory")] = None,

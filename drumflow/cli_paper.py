@@ -25,7 +25,6 @@ from rich.table import Table
 from drumflow.cli_guard import cli_console
 from drumflow.cli_progress import StageProgress, resume_hint
 from drumflow.errors import CaseError, DrumflowError
-from drumflow.readers import read_json_object
 
 console = cli_console()
 err_console = cli_console(stderr=True)
@@ -53,7 +52,10 @@ def _finished(run_dir: Path, case_hash: str) -> bool:
     if not ((run_dir / "stages" / "dem.json").is_file() and summary.is_file()):
         return False
     # A damaged summary is refused by name (BadFileError), not taken for an unfinished run:
-    # rerunning would replace what only the finished run knows.
+    # rerunning would replace what only the finished run knows. Imported here: the CLI's
+    # start-up loads no numerical library (drumflow.readers needs numpy).
+    from drumflow.readers import read_json_object
+
     return bool(read_json_object(summary, "the run's summary").get("case_hash") == case_hash)
 
 

@@ -88,6 +88,7 @@ def air_cache_key(case: Case) -> str:
     because the air field does not depend on them: the particles and contacts (one-way
     coupling: particles do not act on the air), the run settings, ``drum.facet_size`` and
     ``drum.tilt_deg`` (the DEM wall STL and gravity's direction; the air model has no gravity),
+    ``drum.ends`` (the particles' end walls; the air passes the end faces in every case),
     and of the air section ``coupling_interval``, ``pressure_gradient_force``, ``heat_capacity``
     and ``warming`` (they act only on the particle side, or on the air's temperature, not its
     flow; a field option added later must be left out too, or every cached field and every run
@@ -95,7 +96,9 @@ def air_cache_key(case: Case) -> str:
     the key.
     """
     data = case.model_dump(mode="json")
-    drum = {k: v for k, v in data["drum"].items() if k not in ("facet_size", "tilt_deg")}
+    # drum.ends: what closes the section for the particles (planes, turning plates or a
+    # periodic wrap); the air enters and leaves through the end faces in every case.
+    drum = {k: v for k, v in data["drum"].items() if k not in ("facet_size", "tilt_deg", "ends")}
     air = {
         k: v
         for k, v in data["air"].items()

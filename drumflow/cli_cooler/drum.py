@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 import time
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any
@@ -15,6 +16,8 @@ from drumflow.cli_cooler._app import app, console, err_console, guard
 
 if TYPE_CHECKING:
     from drumflow.analysis.closures import SliceClosures
+    from drumflow.analysis.predict import PlantSpec
+    from drumflow.coolers.curtain_air import CurtainAirPoint
     from drumflow.coolers.drum import DrumResult
 
 #: Table 7 of the paper, model one: its exchanger prediction of the plant.
@@ -90,6 +93,62 @@ def plot_drum(result: DrumResult, path: Path, title: str) -> Path:
     return path
 
 
+def plot_curtain_air(points: list[CurtainAirPoint], plant: PlantSpec, path: Path,
+                     title: str) -> Path:
+    """NPK and air outlets over the through-curtain flow, with the all-air limit and the
+    plant's measured outlets."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    finite = [p for p in points if p.curtain_air_m3_s_m is not None]
+    limit = [p for p in points if p.curtain_air_m3_s_m is None]
+    q = [p.curtain_air_m3_s_m or 0.0 for p in finite]
+    fig, ax = plt.subplots(figsize=(7.0, 4.6), dpi=120)
+    ax.plot(q, [p.material_outlet_c for p in finite], "o-", color="tab:brown", label="NPK out")
+    ax.plot(q, [p.air_outlet_c for p in finite], "s--", color="tab:blue", label="air out")
+    for p in limit:
+        ax.axhline(p.material_outlet_c, color="tab:brown", lw=0.8, ls=":",
+                   label=f"all air meets the curtain: NPK {p.material_outlet_c:.1f} °C")
+        ax.axhline(p.air_outlet_c, color="tab:blue", lw=0.8, ls=":",
+                   label=f"all air meets the curtain: air {p.air_outlet_c:.1f} °C")
+    if plant.measured_material_outlet_c is not None:
+        ax.axhspan(plant.measured_material_outlet_c - 3, plant.measured_material_outlet_c + 3,
+                   color="tab:brown", alpha=0.12,
+                   label=f"plant NPK out {plant.measured_material_outlet_c:g} ± 3 °C")
+    if plant.measured_air_outlet_c is not None:
+        ax.axhline(plant.measured_air_outlet_c, color="tab:blue", lw=1.5, alpha=0.4,
+                   label=f"plant air out {plant.measured_air_outlet_c:g} °C (a check)")
+    ax.set_xlabel("air through the curtains (m³/s per metre of drum)")
+    ax.set_ylabel("outlet temperature (°C)")
+    ax.set_xscale("symlog", linthresh=1.0)
+    ax.set_xlim(left=0.0)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7, loc="center right")
+    ax.set_title(title, fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)
+    return path
+
+
+def _curtain_air_option(value: str) -> float | None:
+    """``--curtain-air``: 'all' (None) or a flow in m3/s per metre of drum."""
+    from drumflow.coolers.drum import MAX_CURTAIN_AIR_M3_S_M, DrumModelError
+
+    allowed = (f"allowed 'all' or 0 to {MAX_CURTAIN_AIR_M3_S_M:g} m3/s per metre of drum")
+    if value.strip().lower() == "all":
+        return None
+    try:
+        flow = float(value)
+    except ValueError:
+        raise DrumModelError(f"--curtain-air = {value}: {allowed}") from None
+    if not (math.isfinite(flow) and 0.0 <= flow <= MAX_CURTAIN_AIR_M3_S_M):
+        raise DrumModelError(f"--curtain-air = {value}: {allowed}")
+    return flow
+
+
 @app.command("drum")
 def drum(
     source: Annotated[Path, typer.Argument(
@@ -106,6 +165,15 @@ def drum(
         "--wall-loss", help="wall-loss coefficient U_w, W/(m2 K) over the shell (0 = off)")] = 0.0,
     lumped: Annotated[bool, typer.Option(
         "--lumped", help="lumped particles (Bi -> 0) instead of interior conduction")] = False,
+    curtain_air: Annotated[str, typer.Option(
+        "--curtain-air", help="air through the curtains, m3/s per metre of drum (at the air "
+                              "inlet temperature), or 'all': all the air meets every falling "
+                              "granule (the default: the one setting not chosen from the "
+                              "plant; the bound of most contact). Every run also reports the "
+                              "outlets over a range of it")] = "all",
+    sweep: Annotated[bool, typer.Option(
+        "--sweep/--no-sweep", help="also run the range of through-curtain flows (table, "
+                                   "curtain_air.csv/.png)")] = True,
     closures_start: Annotated[float | None, typer.Option(
         "--start", help="with a run directory: measure the closures from this simulated time "
                         "on, s (default: the case's run.mass_flow_start); e.g. once the "
@@ -120,9 +188,14 @@ def drum(
     """Predict the paper's plant (3 m x 19 m NPK cooler) from slice closures; what-ifs by option."""
     # The models import scipy; loading them here keeps `drumflow --help` and every other
     # command from paying for it at start-up.
-    from drumflow.analysis.predict import PAPER_PLANT, PlantSpec
+    from drumflow.analysis.predict import PAPER_PLANT
     from drumflow.coolers._rundir import open_cooler_run, write_result
     from drumflow.coolers._transport import calibrate
+    from drumflow.coolers.curtain_air import (
+        curtain_air_for_outlet,
+        curtain_air_scales,
+        sweep_curtain_air,
+    )
     from drumflow.coolers.drum import (
         DrumModelError,
         DrumOptions,
@@ -131,6 +204,7 @@ def drum(
         solve_drum,
         volumetric_coefficient_estimate,
     )
+    from drumflow.coolers.plant_balance import measured_balance
 
     with guard():
         for name, value, most in (("--cells", cells, 5000), ("--rpm", rpm, 60.0),
@@ -147,6 +221,7 @@ def drum(
             raise DrumModelError(f"--wall-loss = {wall_loss:g}: allowed >= 0 and <= 1000 W/(m2 K)")
         if closures_start is not None and not closures_start >= 0:
             raise DrumModelError(f"--start = {closures_start}: allowed >= 0 s (simulated time)")
+        curtain_flow = _curtain_air_option(curtain_air)
         if particle_diameter is not None and particle_diameter > 0.05:
             raise DrumModelError(f"--particle-diameter = {particle_diameter}: allowed <= 0.05 m "
                                  "(give it in metres)")
@@ -160,7 +235,8 @@ def drum(
                                         feed_rate_kg_s=feed_rate,
                                         particle_diameter_m=particle_diameter,
                                         length_m=length, tilt_deg=tilt)
-        options = DrumOptions(cells=cells, wall_loss_w_m2k=wall_loss, lumped_particles=lumped)
+        options = DrumOptions(cells=cells, wall_loss_w_m2k=wall_loss, lumped_particles=lumped,
+                              curtain_air_m3_s_m=curtain_flow)
         start = time.perf_counter()
         result = solve_drum(plant, closures, law, options)
         wall = time.perf_counter() - start
@@ -171,6 +247,24 @@ def drum(
         ua, textbook = volumetric_coefficient_estimate(plant)
         exchanger = paper_exchanger(plant)
         what_if = plant != base
+        # The through-curtain flow is the closure no slice measures yet: show what it changes.
+        points: list[CurtainAirPoint] = []
+        needed = None
+        if sweep:
+            points = sweep_curtain_air(plant, closures, law, options)
+            if not what_if and base.measured_material_outlet_c is not None:
+                needed = curtain_air_for_outlet(plant, closures, law, options,
+                                                base.measured_material_outlet_c, points)
+        curtain_payload: dict[str, Any] = {
+            "setting_m3_s_per_m": curtain_flow,
+            "default_note": "default 'all': all the air meets every falling granule, the limit "
+                            "of most contact and the one setting not chosen from the plant; the "
+                            "through-curtain flow awaits a two-way-coupled slice closure and "
+                            "is never fitted to the plant's outlets",
+            "sweep": [p.to_dict() for p in points],
+            "needed_for_measured_material_outlet": needed.to_dict() if needed else None,
+            "scales_m3_s_per_m": curtain_air_scales(plant, result.scaled),
+        }
         payload: dict[str, Any] = {
             "source": str(source),
             "slice": closures.to_dict(),
@@ -184,12 +278,17 @@ def drum(
                 "published_table7": PAPER_TABLE7 if not what_if else None,
                 "note": "Table 7 model one: h = 60.15 W/(m2 K), A_he = 1099.28 m2, this plant's streams",
             },
+            "curtain_air": curtain_payload,
+            "plant_balance": measured_balance(base).to_dict() if not what_if else None,
             "textbook_volumetric": {
                 "Ua_W_m3K": ua,
                 "material_outlet_C": textbook.material_outlet_temperature_c,
                 "air_outlet_C": textbook.air_outlet_temperature_c,
-                "note": "Ua = 0.5 G^0.67 / D (Btu/(h ft3 F), G lb/(h ft2), D ft): McCormick, "
-                        "as given in Perry's Chemical Engineers' Handbook, rotary dryers",
+                "note": "Ua = 0.5 G^0.67 / D (Btu/(h ft3 F), G lb/(h ft2), D ft), i.e. "
+                        "237 G^0.67 / D in W/(m3 K) with G in kg/(s m2), D in m; attributed to "
+                        "McCormick via Perry's (rotary dryers). Checked only against "
+                        "Coulson & Richardson Vol. 2, Example 16.5 (0.25 kW/(m3 K) form, "
+                        "5 % above): a handbook estimate, not a closure",
             },
         }
         inputs = DrumInputs(source=str(source), closures=closures.to_dict(),
@@ -206,6 +305,17 @@ def drum(
                  f"{plant.feed_rate_kg_s:.4g} kg/s NPK, {plant.air_mass_flow_kg_s:g} kg/s air; "
                  f"closures: {closures.case_name}")
         plot = plot_drum(result, rundir.root / "profile.png", title)
+        if points:
+            with (rundir.root / "curtain_air.csv").open("w") as fh:
+                fh.write("curtain_air_m3_s_per_m,material_outlet_C,air_outlet_C,heat_curtain_W,"
+                         "heat_bed_W,curtain_passes\n")
+                for p in points:
+                    flow = "all" if p.curtain_air_m3_s_m is None else f"{p.curtain_air_m3_s_m:.6g}"
+                    passes = "" if p.curtain_passes is None else f"{p.curtain_passes:.6g}"
+                    fh.write(f"{flow},{p.material_outlet_c:.6g},{p.air_outlet_c:.6g},"
+                             f"{p.heat_curtain_w:.6g},{p.heat_bed_w:.6g},{passes}\n")
+            plot_curtain_air(points, plant if what_if else base, rundir.root / "curtain_air.png",
+                             title)
     if as_json:
         console.print_json(json.dumps(payload, default=float))
         return
@@ -227,6 +337,31 @@ def drum(
     table.add_row(f"textbook Ua = {ua:.0f} W/(m³ K)", f"{textbook.material_outlet_temperature_c:.2f}",
                   f"{textbook.air_outlet_temperature_c:.2f}")
     console.print(table)
+    if points:
+        sweep_table = Table(title="over the air through the curtains (not yet measured by a "
+                                  "slice; never fitted to the plant)")
+        sweep_table.add_column("through curtains (m³/s per m)", justify="right")
+        sweep_table.add_column("curtains met by the air", justify="right")
+        sweep_table.add_column("NPK out (°C)", justify="right")
+        sweep_table.add_column("air out (°C)", justify="right")
+        sweep_table.add_column("curtain / bed (kW)", justify="right")
+        for p in points:
+            flow = "all" if p.curtain_air_m3_s_m is None else f"{p.curtain_air_m3_s_m:g}"
+            passes = "—" if p.curtain_passes is None else f"{p.curtain_passes:.2f}"
+            sweep_table.add_row(flow, passes, f"{p.material_outlet_c:.2f}",
+                                f"{p.air_outlet_c:.2f}",
+                                f"{p.heat_curtain_w / 1e3:.0f} / {p.heat_bed_w / 1e3:.0f}")
+        console.print(sweep_table)
+        if needed is not None:
+            if needed.curtain_air_m3_s_m is not None:
+                console.print(f"NPK out {needed.target_material_outlet_c:g} °C needs "
+                              f"{needed.curtain_air_m3_s_m:.2f} m³/s per metre through the "
+                              f"curtains (air out then {needed.air_outlet_c:.1f} °C)")
+            else:
+                console.print(f"NPK out {needed.target_material_outlet_c:g} °C: {needed.reason}")
+            scales = ", ".join(f"{k.replace('_', ' ')} {v['m3_s_per_m']:.2g}"
+                               for k, v in curtain_payload["scales_m3_s_per_m"].items())
+            console.print(f"scales (m³/s per m): {scales}")
     s = result.scaled
     info = Table(show_header=False, title="model")
     info.add_row("heat duty", f"{result.duty_w / 1e3:.1f} kW (curtain {100 * result.curtain_share:.1f} %,"
@@ -244,7 +379,10 @@ def drum(
                  f"{result.h_bed_surface_w_m2k:.0f} W/(m² K), Bi {result.biot_fall:.2f}")
     info.add_row("bed surface", f"{s.bed_surface_m2_per_m:.2f} m²/m")
     info.add_row("energy residual", f"{result.energy_residual:.1e}")
-    info.add_row("written", f"{rundir.root / 'result.json'}, {plot}")
+    written = f"{rundir.root / 'result.json'}, {plot}"
+    if points:
+        written += f", {rundir.root / 'curtain_air.csv'}, {rundir.root / 'curtain_air.png'}"
+    info.add_row("written", written)
     if save_closures is not None:
         info.add_row("closures written", str(save_closures))
     console.print(info)

@@ -40,6 +40,7 @@ def fluid_bed(
         month_conditions,
         operate,
         operate_year,
+        source_cycle_checks,
     )
     from drumflow.errors import CaseError
 
@@ -55,6 +56,7 @@ def fluid_bed(
         # leaves nothing behind.
         if year:
             months = operate_year(case)
+            checks = source_cycle_checks(case)
         elif month is not None:
             weather = {m.month: m for m in load_weather(case.weather.table)}[month]
             op = operate(case, month_conditions(case, weather))
@@ -70,9 +72,12 @@ def fluid_bed(
             plots.plot_year(months, root / "year.png", target)
             hottest = max(months, key=lambda mo: mo[1].unit.conditions.ambient_temperature)
             _unit_outputs(plots, hottest[1], root, target, f"{hottest[0].name}: ")
-            result: dict[str, Any] = {"model": "fluid-bed", "case": case.name, "year": rows}
+            source_rows = [_source_row(c) for c in checks]
+            plots.write_rows_csv(source_rows, root / "source_table_1.csv")
+            result: dict[str, Any] = {"model": "fluid-bed", "case": case.name, "year": rows,
+                                      "source_table_1": source_rows}
             write_result(rundir, result, time.perf_counter() - start)
-            _print_year(rows, root, as_json)
+            _print_year(rows, source_rows, root, as_json)
             return
         _unit_outputs(plots, op, root, target, label)
         summary = {**_flat(op.summary()), **_sections(op)}
@@ -134,6 +139,23 @@ def fit(
         err_console.print(f"results in {root}")
 
 
+def _source_row(check: Any) -> dict[str, Any]:
+    """The source's Table 1 month beside the consistent cycles (kJ/kg of product)."""
+    row, src, river = check.row, check.at_source_temperatures, check.with_river_condensing
+    return {
+        "month": row.month, "duty_kJ_per_kg": row.duty,
+        "evaporating_K": row.evaporating_temperature, "condensing_K": row.condensing_temperature,
+        "source_power_kJ_per_kg": row.power, "source_cop": row.cop,
+        "carnot_cop": row.carnot_cop, "source_exceeds_carnot": row.exceeds_carnot,
+        "consistent_power_kJ_per_kg": src.power / 1e3, "consistent_cop": src.cop,
+        "consistent_refrigerant_kg_per_kg": src.refrigerant_flow / 1e3,
+        "river_condensing_K": river.condensing_temperature if river else None,
+        "river_power_kJ_per_kg": river.power / 1e3 if river else None,
+        "river_cop": river.cop if river else None,
+        "river_carnot_cop": river.carnot_cop if river else None,
+    }
+
+
 def _unit_outputs(plots: Any, op: Any, root: Path, target: float, label: str) -> None:
     unit = op.unit
     plots.write_profile_csv(unit, root / "profile.csv")
@@ -159,7 +181,9 @@ def _sections(op: Any) -> dict[str, Any]:
             "air_in_K": s.air_inlet_temperature, "air_out_K": s.air_outlet_temperature,
             "air_kg_per_s": s.air_mass_flow, "geldart": s.bed.geldart,
             "u_mf_m_per_s": s.bed.min_fluidization_velocity, "u_t_m_per_s": s.bed.terminal_velocity,
-            "bubble_diameter_m": s.bed.bubble_diameter, "bubble_fraction": s.bed.bubble_fraction,
+            "bubble_diameter_m": s.bed.bubble_diameter,
+            "surface_bubble_diameter_m": s.bed.surface_bubble_diameter,
+            "bubble_fraction": s.bed.bubble_fraction,
             "dense_phase_voidage": s.bed.dense_phase_voidage, "voidage": s.bed.voidage,
             "bed_height_m": s.bed.bed_height, "reynolds": s.reynolds,
             "vibration_reynolds": s.vibration_reynolds, "vibration_intensity": s.vibration_intensity,
@@ -188,7 +212,8 @@ def _print_single(summary: dict[str, Any], out: Path, as_json: bool) -> None:
         ("section C supply air", _c(summary["cooled_air_K"])),
         ("air-cooler duty", f"{summary['air_cooler_duty_kJ_per_kg']:.3f} kJ/kg"),
         ("compressor power", f"{summary['compressor_power_kJ_per_kg']:.3f} kJ/kg"),
-        ("COP", "-" if summary["cop"] is None else f"{summary['cop']:.2f}"),
+        ("COP (Carnot)", "-" if summary["cop"] is None
+         else f"{summary['cop']:.2f} ({summary['carnot_cop']:.2f})"),
         ("particle centre - surface at outlet", f"{summary['particle_centre_minus_surface_K']:.2f} K"),
         ("product heat / hood loss", f"{summary['product_heat_kW']:.1f} / {summary['loss_kW']:.2f} kW"),
         ("energy closure", f"{summary['energy_closure']:.1e}"),
@@ -196,8 +221,8 @@ def _print_single(summary: dict[str, Any], out: Path, as_json: bool) -> None:
     for s in summary["sections"]:
         rows.append((f"{s['section']}: h, f_c h, Bi",
                      f"{s['h_W_m2K']:.0f}, {s['fc_h_W_m2K']:.0f} W/m2K, {s['biot']:.2f}"))
-        rows.append((f"{s['section']}: voidage, bed height",
-                     f"{s['voidage']:.3f}, {s['bed_height_m']:.2f} m"))
+        rows.append((f"{s['section']}: voidage, bed height, bubble (mean)",
+                     f"{s['voidage']:.3f}, {s['bed_height_m']:.3f} m, {s['bubble_diameter_m']:.3f} m"))
     for name, value in rows:
         table.add_row(name, value)
     console.print(table)
@@ -206,13 +231,14 @@ def _print_single(summary: dict[str, Any], out: Path, as_json: bool) -> None:
     err_console.print(f"results in {out}")
 
 
-def _print_year(rows: list[dict[str, Any]], out: Path, as_json: bool) -> None:
+def _print_year(rows: list[dict[str, Any]], source_rows: list[dict[str, Any]], out: Path,
+                as_json: bool) -> None:
     if as_json:
-        console.print_json(json.dumps(rows, default=float))
+        console.print_json(json.dumps({"year": rows, "source_table_1": source_rows}, default=float))
         return
     table = Table(title="vibrating fluid-bed cooler over the year", show_header=True)
     for name in ("month", "air (°C)", "product, ambient only (K)", "chill?", "product (K)",
-                 "cooled air (°C)", "duty (kJ/kg)", "power (kJ/kg)", "COP"):
+                 "cooled air (°C)", "duty (kJ/kg)", "power (kJ/kg)", "COP", "Carnot"):
         table.add_column(name, justify="right")
     for r in rows:
         table.add_row(r["name"], f"{r['ambient_K'] - 273.15:.1f}",
@@ -220,6 +246,27 @@ def _print_year(rows: list[dict[str, Any]], out: Path, as_json: bool) -> None:
                       f"{r['product_outlet_K']:.2f}",
                       "-" if r["cooled_air_K"] is None else f"{r['cooled_air_K'] - 273.15:.1f}",
                       f"{r['air_cooler_duty_kJ_per_kg']:.2f}", f"{r['compressor_power_kJ_per_kg']:.3f}",
-                      "-" if r["cop"] is None else f"{r['cop']:.2f}")
+                      "-" if r["cop"] is None else f"{r['cop']:.2f}",
+                      "-" if r["carnot_cop"] is None else f"{r['carnot_cop']:.2f}")
     console.print(table)
+    src = Table(title="the source's Table 1 (its duty and evaporating temperature) with a "
+                "consistent cycle", show_header=True)
+    for name in ("month", "duty (kJ/kg)", "T_evap (K)", "T_cond (K)", "source power", "source COP",
+                 "Carnot", "consistent power", "COP", "river T_cond (K)", "river power", "river COP",
+                 "river Carnot"):
+        src.add_column(name, justify="right")
+    for r in source_rows:
+        river = r["river_condensing_K"] is not None
+        src.add_row(r["month"], f"{r['duty_kJ_per_kg']:.3f}", f"{r['evaporating_K']:.2f}",
+                    f"{r['condensing_K']:.2f}", f"{r['source_power_kJ_per_kg']:.3f}",
+                    f"{r['source_cop']:.2f}" + (" > Carnot" if r["source_exceeds_carnot"] else ""),
+                    f"{r['carnot_cop']:.2f}", f"{r['consistent_power_kJ_per_kg']:.3f}",
+                    f"{r['consistent_cop']:.2f}",
+                    f"{r['river_condensing_K']:.2f}" if river else "-",
+                    f"{r['river_power_kJ_per_kg']:.3f}" if river else "-",
+                    f"{r['river_cop']:.2f}" if river else "-",
+                    f"{r['river_carnot_cop']:.2f}" if river else "-")
+    console.print(src)
+    err_console.print("powers in kJ per kg of product; the consistent cycles use the case's "
+                      "compressor (polytropic efficiency) and refrigerant")
     err_console.print(f"results in {out}")

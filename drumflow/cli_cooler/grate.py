@@ -15,7 +15,9 @@ from drumflow.cli_cooler._app import app, console, err_console, guard
 _VARY_HELP = (
     "sweep one field: FIELD=START:STOP:COUNT or FIELD=V1,V2,...; FIELD is grate_speed, "
     "clinker_flow, air_flow, clinker_inlet_temperature, air_inlet_temperature, "
-    "particle_diameter, bed_porosity, emissivity, length, width, or section.field"
+    "particle_diameter, bed_porosity, emissivity, length, width, fan_pressure, "
+    "fan_free_delivery, or section.field (air_flow only with air.supply = 'fixed': a fan "
+    "case solves it)"
 )
 
 
@@ -28,7 +30,10 @@ def grate(
     as_json: Annotated[bool, typer.Option("--json", help="print the result as JSON")] = False,
 ) -> None:
     """Clinker grate cooler: cross-flow balance cells solved by line-by-line TDMA (the
-    IIT Madras / NCL report); prints outlet temperatures, recovered heat, efficiency."""
+    IIT Madras / NCL report); prints outlet temperatures, recovered heat, efficiency. With
+    air.supply = "fan" the air flow is where the fan curve meets the bed's Ergun pressure
+    drop (cases/grate_cooler_fans.toml); a --vary study prints where the recovered heat
+    and the secondary air are largest."""
     from drumflow.coolers._rundir import open_cooler_run, write_result
     from drumflow.coolers.grate import plots
     from drumflow.coolers.grate.case import load_grate_case
@@ -71,9 +76,13 @@ def grate(
         plots.write_csv(rows, root / "sweep.csv")
         plots.plot_sweep(sweep, root / "sweep_profiles.png")
         plots.plot_sweep_outlets(sweep, root / "sweep_outlets.png")
-        write_result(rundir, {"model": "grate", "case": case.name, "vary": field, "rows": rows},
+        plots.plot_sweep_recovered(sweep, root / "sweep_recovered.png")
+        peaks = {column: dict(zip(("at", "value", "interior"), sweep.peak(column), strict=True))
+                 for column in ("heat_recovered_MW", "secondary_air_K")}
+        write_result(rundir, {"model": "grate", "case": case.name, "vary": field,
+                              "air_supply": case.air.supply, "rows": rows, "maxima": peaks},
                      time.perf_counter() - start)
-        _print_sweep(field, rows, root, as_json)
+        _print_sweep(field, rows, peaks, root, as_json)
 
 
 def _print_single(summary: dict[str, Any], out: Path, as_json: bool) -> None:
@@ -87,6 +96,9 @@ def _print_single(summary: dict[str, Any], out: Path, as_json: bool) -> None:
         ("clinker outlet (caloric)", f"{summary['clinker_outlet_temperature_K']:.1f} K"),
         ("secondary air (freeboard, kiln end)", f"{summary['secondary_air_temperature_K']:.1f} K"),
         ("heat recovered by the air", f"{summary['heat_recovered_MW']:.2f} MW"),
+        (f"air flow ({'fan operating point' if summary['air_supply'] == 'fan' else 'given'})",
+         f"{summary['air_flow_kg_s']:.3f} kg/s"),
+        ("bed pressure drop (Ergun)", f"{summary['bed_pressure_drop_Pa']:.0f} Pa"),
         ("heat duty (clinker to air inlet T)", f"{summary['heat_duty_MW']:.2f} MW"),
         ("cooler efficiency", f"{100 * summary['cooler_efficiency']:.1f} %"),
         ("radiation bed top -> freeboard", f"{summary['radiation_heat_MW']:.3f} MW"),
@@ -100,22 +112,33 @@ def _print_single(summary: dict[str, Any], out: Path, as_json: bool) -> None:
     )
     for name, value in shown:
         table.add_row(name, value)
+    if "fan_pressure_Pa" in summary:
+        table.add_row("fan pressure rise (curve)", f"{summary['fan_pressure_Pa']:.0f} Pa")
     console.print(table)
     err_console.print(f"results in {out}")
 
 
-def _print_sweep(field: str, rows: list[dict[str, float]], out: Path, as_json: bool) -> None:
+def _print_sweep(field: str, rows: list[dict[str, float]], peaks: dict[str, dict[str, Any]],
+                 out: Path, as_json: bool) -> None:
     if as_json:
-        console.print_json(json.dumps({"vary": field, "rows": rows}))
+        console.print_json(json.dumps({"vary": field, "rows": rows, "maxima": peaks}))
         return
     table = Table(title=f"clinker grate cooler: varying {field}", show_header=True)
     for name in (field, "clinker outlet (K)", "secondary air (K)", "recovered (MW)",
-                 "efficiency (%)", "bed height (m)", "solve (s)"):
+                 "efficiency (%)", "air (kg/s)", "bed dp (Pa)", "bed height (m)", "solve (s)"):
         table.add_column(name, justify="right")
     for r in rows:
         table.add_row(f"{r[field]:.4g}", f"{r['clinker_outlet_K']:.1f}",
                       f"{r['secondary_air_K']:.1f}", f"{r['heat_recovered_MW']:.2f}",
-                      f"{100 * r['efficiency']:.1f}", f"{r['bed_height_m']:.3f}",
+                      f"{100 * r['efficiency']:.1f}", f"{r['air_flow_kg_s']:.2f}",
+                      f"{r['bed_pressure_drop_Pa']:.0f}", f"{r['bed_height_m']:.3f}",
                       f"{r['wall_time_s']:.2f}")
     console.print(table)
+    for column, what, unit, digits in (("heat_recovered_MW", "recovered heat", "MW", 2),
+                                       ("secondary_air_K", "secondary air", "K", 1)):
+        p = peaks[column]
+        where = ("inside the range" if p["interior"]
+                 else "at the end of the range: no maximum inside it")
+        console.print(f"largest {what}: {p['value']:.{digits}f} {unit} at {field} = "
+                      f"{p['at']:.4g} ({where})")
     err_console.print(f"results in {out}")

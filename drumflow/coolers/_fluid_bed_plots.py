@@ -119,11 +119,15 @@ def plot_year(months: list[tuple[MonthWeather, Operation]], path: Path, target_K
     ax1.set_ylabel("temperature (°C)")
     ax1.legend(fontsize=8, loc="upper left")
     ax1.grid(alpha=0.3)
-    ax1.set_title("shaded: months that need chilled air in section C", fontsize=10)
+    # Say so when no month needs chilling (an empty shading legend would read as a bug).
+    chilled = any(op.cooling_needed for _, op in months)
+    ax1.set_title("shaded: months that need chilled air in section C" if chilled
+                  else "no month needs chilled air in section C", fontsize=10)
     w = 0.38
     ax2.bar(x - w / 2, duty, w, color="tab:cyan", label="air-cooler duty")
     ax2.bar(x + w / 2, power, w, color="tab:purple", label="compressor power")
     ax2.set_ylabel("kJ per kg of product")
+    ax2.set_ylim(bottom=0.0, top=max([*duty, *power, 1.0]) * 1.1)
     ax2.set_xticks(x, labels)
     ax2.legend(fontsize=8, loc="upper left")
     ax2.grid(alpha=0.3, axis="y")

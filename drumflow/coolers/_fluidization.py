@@ -1,24 +1,49 @@
 """Bubbling-bed hydrodynamics and gas-particle convection of the vibrating fluid-bed cooler.
 
-Every correlation here is the one named in the fluid-bed source's text (its equations were
-images and are missing), taken from the cited literature, in SI units:
+Correlations, in SI units:
 
 - humid-air properties: CoolProp's ``HAPropsSI`` (Lemmon et al. 2000 dry air, IAPWS-95
   water, Hyland and Wexler 1983 mixing);
-- minimum fluidisation velocity: Wen and Yu (1966);
+- minimum fluidisation velocity: Wen and Yu (1966), and the voidage at minimum fluidisation
+  their correlation implies in its inertial (large Archimedes number) limit,
+  1 / (phi eps_mf^3) = 14;
 - terminal velocity of a sphere: Haider and Levenspiel (1989);
-- Richardson and Zaki (1954) expansion, u = u_t eps^n, with the exponent fitted by Rowe (1987);
-- bubble equivalent diameter above a perforated plate: Darton et al. (1977), the correlation
-  Karimipour and Pugsley (2011) found best for Geldart B and D beds, with the catchment area
-  per orifice A_t / n that the source's eq. 15 names;
-- bubble rise velocity and visible bubble flow: Hilligardt and Werther (1986), as used by
-  Lehmann et al. (2019);
-- dense (suspension) phase gas velocity: the gas balance of the two-phase model
-  (Clift and Grace 1985);
-- hold-up and bed height: Lehmann et al. (2019) and Picado and Martinez (2012);
+- bed expansion (bubble fraction) of a freely bubbling bed at high excess velocity:
+  Johnsson, Andersson and Leckner (1991, Powder Technol. 68, 117-123), with the dense
+  (emulsion) phase at eps_mf (two-phase theory, Toomey and Johnstone 1952; Kunii and
+  Levenspiel 1991, ch. 6);
+- bubble equivalent diameter above a perforated plate: Darton et al. (1977), with the
+  catchment area per orifice A_t / n that the source's eq. 15 names (reported, and used to
+  say where the bed stands; it does not enter the voidage);
+- hold-up and bed height: Picado and Martinez (2012), H = S / (v B rho_p (1 - eps));
 - vibration intensity and vibration Reynolds number: the usual definitions
   (Gamma = A (2 pi f)^2 / g; Re_v = rho_g A (2 pi f) d / mu_g);
 - particle Nusselt number in the bed: Gunn (1978).
+
+Why not the source's Richardson-Zaki dense phase (issue 34). The source (after Lehmann et al.
+2019) puts the suspension phase at the Richardson and Zaki (1954) voidage of the gas it
+carries, eps_d = (u_d / u_t)^(1/n). That is particulate (liquid-like) expansion, which gas
+beds of Geldart B and D particles do not show: their excess gas goes into bubbles and the
+emulsion stays near minimum fluidisation (two-phase theory). Applied to 2.7 mm granules at
+7.5 m/s (u / u_mf = 6.6) it gave a dense phase at eps_d = 0.98, a bed voidage of 0.989, a
+3.63 m bed on a 1 m wide deck and 1.16 m bubbles. Johnsson et al. fitted the bubble fraction
+of freely bubbling beds of coarse particles (fluidised-bed boiler conditions, excess
+velocities of metres per second), where the two-phase theory with the visible bubble flow
+over-predicts it; their correlation is the bed expansion used here.
+
+Where a vibrated, shallow Geldart D bed stands. At the cooler's velocities (u / u_mf = 4.4
+in section B and 6.6 in C) the gas, not the vibration, carries the bed: vibration lowers
+the minimum fluidisation velocity and loosens the bed near and below u_mf, and its effect on
+the bed fades as u rises well above u_mf (Gupta and Mujumdar 1980, Can. J. Chem. Eng. 58,
+332; Pakowski et al. 1984), so no vibration term enters the expansion. The bed is shallow
+(H ~ 0.1 m) and Darton's bubbles reach its depth (0.14-0.18 m at the surface): it is at
+the end of the bubbling regime, past the onset of turbulent fluidisation of Bi and Grace
+(1995), Re_c = 1.24 Ar^0.45 (u_c ~ 4 m/s here). Johnsson's correlation is extrapolated to
+these conditions (2.7 mm, u - u_mf = 3.9-6.4 m/s); its particle-size factor has reached its
+coarse-particle limit. The voidage it gives (0.57-0.60) is the bubbling-bed estimate; the
+source's own bubble equations with the emulsion at eps_mf (Hilligardt and Werther's visible
+bubble flow, psi = 0.26) give 0.74-0.79 at the same points, which bounds the uncertainty of
+the bed's expansion here. Both are far from 0.99.
 
 Why Gunn and not Pakowski et al. (1984): the source takes its Nusselt number from Pakowski,
 Mujumdar and Strumillo (1984, Advances in Drying 3, pp. 245-306), a function of the gas
@@ -26,9 +51,9 @@ Reynolds number, the vibration Reynolds number and Gamma; that chapter's equatio
 be retrieved for this work, and inventing its coefficients is not an option. Gunn's
 correlation is the standard gas-particle Nusselt number of fixed and fluidised beds
 (0.35 <= eps <= 1, Re <= 1e5); vibration enters it only through the bed voidage. The
-source multiplies the Nusselt number by a fitted efficiency f_c anyway ("even though h is
-a perfectly defined variable, in the model, it is one of the adjustable parameters"), so
-the level of h is set by the plant data, not by the correlation.
+source multiplies the Nusselt number by a fitted efficiency f_c ("even though h is a
+perfectly defined variable, in the model, it is one of the adjustable parameters"); the
+source's f_c = 0.30 belongs to Pakowski's correlation and does not carry over to Gunn's.
 """
 
 from __future__ import annotations
@@ -39,15 +64,18 @@ from typing import Literal
 
 import CoolProp.CoolProp as CP
 import numpy as np
-from scipy.optimize import brentq
 
 GRAVITY = 9.81  # m/s^2
 
 GeldartGroup = Literal["A", "B", "C", "D"]
 
-#: Visible bubble flow ratio psi = (eps_b u_b) / (u - u_mf) of Hilligardt and Werther (1986)
-#: for the Geldart groups their correlation covers.
-VISIBLE_BUBBLE_FLOW_RATIO: dict[str, float] = {"B": 0.67, "D": 0.26}
+#: Geldart groups the bubbling-bed correlations cover: Johnsson et al. (1991) fitted coarse
+#: (B and D) particles; group A beds expand without bubbles first, group C do not fluidise.
+BUBBLING_GROUPS: tuple[GeldartGroup, ...] = ("B", "D")
+
+#: 1 / (phi eps_mf^3) of Wen and Yu (1966) in the inertial limit (their 1.75 / (phi eps^3)
+#: = 24.5 Ergun term, 24.5 / 1.75 = 14).
+WEN_YU_INERTIAL = 14.0
 
 
 # -- air ---------------------------------------------------------------------------------------
@@ -146,12 +174,17 @@ def terminal_velocity(diameter: float, particle_density: float, gas: HumidAir) -
     return u_star * scale
 
 
-def richardson_zaki_exponent(diameter: float, particle_density: float, gas: HumidAir) -> float:
-    """Rowe (1987) fit of the Richardson-Zaki exponent:
-    n = (4.7 + 0.41 Re_t^0.75) / (1 + 0.175 Re_t^0.75), Re_t on the terminal velocity."""
-    re_t = gas.density * terminal_velocity(diameter, particle_density, gas) * diameter / gas.viscosity
-    x = re_t**0.75
-    return (4.7 + 0.41 * x) / (1.0 + 0.175 * x)
+def min_fluidization_voidage(sphericity: float = 1.0) -> float:
+    """Voidage at minimum fluidisation from Wen and Yu (1966): 1 / (phi eps_mf^3) = 14.
+
+    Their two approximations, 1 / (phi eps_mf^3) ~ 14 and (1 - eps_mf) / (phi^2 eps_mf^3) ~ 11,
+    are the two Ergun terms of their u_mf correlation; the first (the inertial term) sets u_mf
+    at the cooler's Archimedes numbers (~1e6), so it is the eps_mf consistent with the u_mf
+    used here: 14^(-1/3) = 0.415 for spheres.
+    """
+    if not 0.0 < sphericity <= 1.0:
+        raise ValueError(f"sphericity = {sphericity!r}: allowed > 0 and <= 1")
+    return (WEN_YU_INERTIAL * sphericity) ** (-1.0 / 3.0)
 
 
 def geldart_group(diameter: float, particle_density: float, gas_density: float) -> GeldartGroup:
@@ -181,38 +214,69 @@ def darton_bubble_diameter(excess_velocity: float, height: float | np.ndarray,
             / GRAVITY**0.2)
 
 
-def bubble_rise_velocity(excess_velocity: float, bubble_diameter: float | np.ndarray,
-                         psi: float) -> float | np.ndarray:
-    """Hilligardt and Werther (1986): u_b = psi (u - u_mf) + 0.711 sqrt(g d_v), m/s.
+def johnsson_bubble_fraction(excess_velocity: float, diameter: float) -> float:
+    """Bubble volume fraction of a freely bubbling bed, Johnsson, Andersson and Leckner (1991):
 
-    Their bed-geometry factor on the single-bubble term is taken as 1 (the Davidson and
-    Harrison 1963 value): the cooler's bed is wide and shallow, far from the slugging limit
-    that factor corrects for.
+    delta_b = 1 / (1 + 1.3 f^-1 (u - u_mf)^-0.8),
+    f = (0.26 + 0.70 exp(-3.3 d_p)) (0.15 + (u - u_mf))^-0.33,
+
+    with u - u_mf in m/s and d_p in mm (here converted from m). The dense phase is at eps_mf,
+    so the bed voidage is delta_b + (1 - delta_b) eps_mf and H / H_mf = 1 / (1 - delta_b).
+
+    Parameters
+    ----------
+    excess_velocity
+        u - u_mf, m/s (> 0).
+    diameter
+        Particle diameter, m.
     """
-    return psi * excess_velocity + 0.711 * np.sqrt(GRAVITY * bubble_diameter)
+    if not excess_velocity > 0.0:
+        raise ValueError(f"excess velocity u - u_mf = {excess_velocity!r} m/s: must be > 0")
+    d_mm = diameter * 1e3
+    f = (0.26 + 0.70 * math.exp(-3.3 * d_mm)) * (0.15 + excess_velocity) ** -0.33
+    return 1.0 / (1.0 + 1.3 / f * excess_velocity**-0.8)
 
 
 @dataclass(frozen=True)
 class BedState:
-    """The hydrodynamic state of one section of the bed (averaged over its height)."""
+    """The hydrodynamic state of one section of the bed (averaged over its height).
+
+    Attributes
+    ----------
+    geldart
+        Geldart group.
+    min_fluidization_velocity, terminal_velocity
+        m/s.
+    dense_phase_voidage
+        eps_mf: the emulsion stays at minimum fluidisation (two-phase theory).
+    bubble_fraction
+        delta_b of Johnsson et al. (1991).
+    voidage
+        delta_b + (1 - delta_b) eps_mf.
+    bed_height
+        m, from the hold-up of the solids.
+    bubble_diameter
+        Darton's bubble diameter averaged over the bed height, m (reported).
+    surface_bubble_diameter
+        Darton's bubble diameter at the bed surface, m (reported: compared with the bed
+        height it says how far the bed is from freely bubbling).
+    """
 
     geldart: GeldartGroup
     min_fluidization_velocity: float
     terminal_velocity: float
-    richardson_zaki_n: float
-    bubble_diameter: float
-    bubble_rise_velocity: float
-    bubble_fraction: float
-    dense_phase_velocity: float
     dense_phase_voidage: float
+    bubble_fraction: float
     voidage: float
     bed_height: float
+    bubble_diameter: float
+    surface_bubble_diameter: float
 
 
 def bed_state(velocity: float, gas: HumidAir, diameter: float, particle_density: float,
               solids_flow: float, solids_velocity: float, width: float,
-              orifice_area: float) -> BedState:
-    """Hydrodynamics of a bubbling section, solved for the bed height that holds the solids.
+              orifice_area: float, dense_phase_voidage: float | None = None) -> BedState:
+    """Hydrodynamics of a bubbling section of the deck.
 
     Parameters
     ----------
@@ -229,30 +293,33 @@ def bed_state(velocity: float, gas: HumidAir, diameter: float, particle_density:
     width
         Bed width B, m.
     orifice_area
-        Distributor area per orifice A_t / n, m^2.
+        Distributor area per orifice A_t / n, m^2 (for the reported bubble diameters).
+    dense_phase_voidage
+        eps_mf; default :func:`min_fluidization_voidage` for spheres (Wen and Yu 1966).
 
     Notes
     -----
-    Bubble fraction eps_b = psi (u - u_mf) / u_b (visible bubble flow, Hilligardt and Werther
-    1986), averaged over the bed height with the Darton bubble diameter at each height; the
-    dense phase carries the rest of the gas, u_d = (u - psi (u - u_mf)) / (1 - eps_b)
-    (Clift and Grace 1985), at the Richardson-Zaki voidage eps_d = (u_d / u_t)^(1/n); the
-    hold-up is eps = eps_b + (1 - eps_b) eps_d (Lehmann et al. 2019) and the bed height
-    H = S / (v B rho_p (1 - eps)) (Picado and Martinez 2012), solved with eps(H).
+    Bubble fraction delta_b from Johnsson et al. (1991) (:func:`johnsson_bubble_fraction`),
+    dense phase at eps_mf, bed voidage eps = delta_b + (1 - delta_b) eps_mf and bed height
+    H = S / (v B rho_p (1 - eps)) (the source's eq. 20, Picado and Martinez 2012). The
+    bubble fraction does not depend on H, so nothing is iterated. Darton's bubble diameter
+    (source's eq. 15) is averaged over H (16-point Gauss-Legendre) and given at the surface.
 
     Raises
     ------
     ValueError
-        Outside the correlations' range (not fluidised, elutriated, Geldart A or C).
+        Outside the correlations' range (not fluidised, elutriated, Geldart A or C, eps_mf
+        outside 0.35..0.6).
     """
     group = geldart_group(diameter, particle_density, gas.density)
-    if group not in VISIBLE_BUBBLE_FLOW_RATIO:
-        raise ValueError(f"Geldart group {group}: the bubble correlations (Hilligardt and "
-                         "Werther 1986) cover groups B and D only")
-    psi = VISIBLE_BUBBLE_FLOW_RATIO[group]
+    if group not in BUBBLING_GROUPS:
+        raise ValueError(f"Geldart group {group}: the bed-expansion correlation (Johnsson et al. "
+                         "1991) covers groups B and D only")
+    eps_mf = min_fluidization_voidage() if dense_phase_voidage is None else dense_phase_voidage
+    if not 0.35 <= eps_mf <= 0.6:
+        raise ValueError(f"minimum fluidisation voidage {eps_mf!r}: allowed 0.35 to 0.6")
     u_mf = minimum_fluidization_velocity(diameter, particle_density, gas)
     u_t = terminal_velocity(diameter, particle_density, gas)
-    n = richardson_zaki_exponent(diameter, particle_density, gas)
     if velocity <= u_mf:
         raise ValueError(f"superficial velocity {velocity:.3g} m/s is not above the minimum "
                          f"fluidisation velocity {u_mf:.3g} m/s")
@@ -260,31 +327,14 @@ def bed_state(velocity: float, gas: HumidAir, diameter: float, particle_density:
         raise ValueError(f"superficial velocity {velocity:.3g} m/s is not below the particles' "
                          f"terminal velocity {u_t:.3g} m/s (the bed would be blown out)")
     excess = velocity - u_mf
-    # Gauss-Legendre nodes for the height average of the bubble fraction.
+    delta = johnsson_bubble_fraction(excess, diameter)
+    eps = delta + (1.0 - delta) * eps_mf
+    height = solids_flow / (solids_velocity * width * particle_density * (1.0 - eps))
     nodes, weights = np.polynomial.legendre.leggauss(16)
-
-    def averages(height: float) -> tuple[float, float, float]:
-        h = 0.5 * height * (nodes + 1.0)
-        d_v = np.asarray(darton_bubble_diameter(excess, h, orifice_area))
-        u_b = np.asarray(bubble_rise_velocity(excess, d_v, psi))
-        eps_b = psi * excess / u_b
-        w = 0.5 * weights
-        return float(w @ eps_b), float(w @ d_v), float(w @ u_b)
-
-    def voidage(height: float) -> tuple[float, float, float]:
-        eps_b = averages(height)[0]
-        u_d = (velocity - psi * excess) / (1.0 - eps_b)
-        eps_d = min((u_d / u_t) ** (1.0 / n), 1.0)
-        return eps_b + (1.0 - eps_b) * eps_d, u_d, eps_d
-
-    def residual(height: float) -> float:
-        eps = voidage(height)[0]
-        return height * (1.0 - eps) - solids_flow / (solids_velocity * width * particle_density)
-
-    height = float(brentq(residual, 1e-6, 1e3, xtol=1e-12, rtol=1e-12))
-    eps, u_d, eps_d = voidage(height)
-    eps_b, d_v, u_b = averages(height)
-    return BedState(group, u_mf, u_t, n, d_v, u_b, eps_b, u_d, eps_d, eps, height)
+    d_v = np.asarray(darton_bubble_diameter(excess, 0.5 * height * (nodes + 1.0), orifice_area))
+    mean_d_v = float(0.5 * weights @ d_v)
+    top_d_v = float(darton_bubble_diameter(excess, height, orifice_area))
+    return BedState(group, u_mf, u_t, eps_mf, delta, eps, height, mean_d_v, top_d_v)
 
 
 # -- vibration and convection ------------------------------------------------------------------

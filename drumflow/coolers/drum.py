@@ -53,6 +53,7 @@ from scipy.optimize import brentq
 from drumflow.analysis.closures import BED_PACKING, SliceClosures
 from drumflow.analysis.exchanger import ExchangerResult, solve_outlet_temperature
 from drumflow.analysis.predict import PlantSpec
+from drumflow.coolers._curtain_pass import curtain_pass
 from drumflow.coolers._fall import Fall, fall_kinematics
 from drumflow.coolers._propagator import exposure_matrix
 from drumflow.coolers._transport import TransportLaw
@@ -76,6 +77,9 @@ __all__ = [
 
 #: Conductivity standing for a lumped particle (Bi -> 0), W/(m K).
 LUMPED_CONDUCTIVITY = 1.0e4
+#: Largest through-curtain flow accepted, m^3/s per metre of drum: far beyond where the result
+#: has reached the all-air limit (the plant's drum carries ~1 m^3/s per metre axially).
+MAX_CURTAIN_AIR_M3_S_M = 1.0e4
 _PRESSURE_KPA = 101.325
 
 
@@ -99,6 +103,15 @@ class DrumOptions:
         interior conduction changes.
     bed_exchange
         Include the bed-surface term.
+    curtain_air_m3_s_m
+        Air that passes through the curtains, m^3/s per metre of drum (volume at the air
+        inlet temperature). ``None`` (the default): all the air meets every falling granule,
+        the curtain model in the limit where the curtain's gas is the cell's air (an unbounded
+        through-curtain flow; the model before issue 34, kept as this setting). A number: that
+        stream runs through the curtain model and mixes back, the rest bypasses the curtains
+        (module notes, "Air through the curtains").
+    curtain_rows
+        Rows of the curtain's element array with a through-curtain flow.
     """
 
     cells: int = 40
@@ -107,6 +120,8 @@ class DrumOptions:
     ambient_temperature_c: float = 30.0
     lumped_particles: bool = False
     bed_exchange: bool = True
+    curtain_air_m3_s_m: float | None = None
+    curtain_rows: int = 5
 
     def __post_init__(self) -> None:
         if not 1 <= self.cells <= 5000:
@@ -115,6 +130,20 @@ class DrumOptions:
             raise DrumModelError(f"shells = {self.shells}: allowed 2 to 200")
         if not (self.wall_loss_w_m2k >= 0 and math.isfinite(self.wall_loss_w_m2k)):
             raise DrumModelError(f"wall_loss_w_m2k = {self.wall_loss_w_m2k}: allowed >= 0")
+        q = self.curtain_air_m3_s_m
+        if q is not None and not (math.isfinite(q) and 0.0 <= q <= MAX_CURTAIN_AIR_M3_S_M):
+            raise DrumModelError(
+                f"curtain_air_m3_s_m = {q}: allowed 0 to {MAX_CURTAIN_AIR_M3_S_M:g} m3/s per "
+                "metre of drum, or None (all the air meets every falling granule)"
+            )
+        if not 1 <= self.curtain_rows <= 50:
+            raise DrumModelError(f"curtain_rows = {self.curtain_rows}: allowed 1 to 50")
+
+    @property
+    def all_air_meets_curtain(self) -> bool:
+        """True for the limit where the curtain's gas is the cell's air (no through-curtain
+        flow given)."""
+        return self.curtain_air_m3_s_m is None
 
 
 @dataclass(frozen=True)
@@ -227,6 +256,16 @@ class DrumResult:
         Per-cell heats.
     energy_residual
         ``(solids enthalpy loss - air gain - wall loss) / solids enthalpy loss``.
+    curtain_air_kg_s_m
+        Through-curtain air per metre of drum, kg/(s m) (``inf``: all the air meets the
+        curtain).
+    cell_curtain_air_out_c
+        Temperature of the through-curtain air leaving each cell's curtain (the cell's air
+        when all the air meets the curtain).
+    curtain_saturation
+        Heat-weighted mean over the cells of how close the through-curtain air comes to the
+        particles: ``(T_out - T_air) / (T_solids - T_air)``, 1 for a saturated curtain (NaN
+        when all the air meets the curtain).
     """
 
     plant: PlantSpec
@@ -251,12 +290,53 @@ class DrumResult:
     biot_fall: float
     energy_residual: float
     property_iterations: int
+    curtain_air_kg_s_m: float
+    cell_curtain_air_out_c: FloatArray
+    curtain_saturation: float
     warnings: list[str] = field(default_factory=list)
 
     @property
     def duty_w(self) -> float:
         """Heat removed from the solids (to air and through the wall)."""
         return self.heat_to_air_w + self.wall_loss_w
+
+    def air_streams(self) -> dict[str, Any]:
+        """The axial air split into the stream through the curtains and the bypass.
+
+        Per cell, ``through_share_per_cell`` of the axial air crosses the cell's curtains and
+        mixes back; the rest bypasses them. ``curtain_passes`` is the through-curtain mass over
+        the drum divided by the axial air: how many curtains the air meets on its way (below 1,
+        the share of the air that meets any).
+        """
+        plant = self.plant
+        q = self.options.curtain_air_m3_s_m
+        if q is None:
+            return {
+                "setting": "all",
+                "note": "all the air meets every falling granule: the curtain's gas is the "
+                        "cell's air (the limit of an unbounded through-curtain flow)",
+                "through_curtain_m3_s_per_m": None,
+                "through_curtain_kg_s_total": None,
+                "through_share_per_cell": 1.0,
+                "bypass_share_per_cell": 0.0,
+                "curtain_passes": None,
+                "curtain_saturation": None,
+            }
+        dz = plant.length_m / self.options.cells
+        total = self.curtain_air_kg_s_m * plant.length_m
+        share = self.curtain_air_kg_s_m * dz / plant.air_mass_flow_kg_s
+        return {
+            "setting": "through-curtain flow",
+            "note": "the through-curtain stream runs through the curtain model (a dense curtain "
+                    "saturates it) and mixes back; the rest of the air bypasses the curtains",
+            "through_curtain_m3_s_per_m": q,
+            "through_curtain_kg_s_total": total,
+            "through_share_per_cell": share,
+            "bypass_share_per_cell": max(0.0, 1.0 - share),
+            "curtain_passes": total / plant.air_mass_flow_kg_s,
+            "curtain_saturation": self.curtain_saturation,
+            "axial_air_kg_s": plant.air_mass_flow_kg_s,
+        }
 
     def to_dict(self) -> dict[str, Any]:
         return {
@@ -273,6 +353,7 @@ class DrumResult:
             "biot_fall": self.biot_fall,
             "energy_residual": self.energy_residual,
             "property_iterations": self.property_iterations,
+            "air_streams": self.air_streams(),
             "plant": asdict(self.plant),
             "options": asdict(self.options),
             "transport_law": asdict(self.law),
@@ -284,6 +365,7 @@ class DrumResult:
                 "cell_curtain_W": self.cell_curtain_w.tolist(),
                 "cell_bed_W": self.cell_bed_w.tolist(),
                 "cell_wall_W": self.cell_wall_w.tolist(),
+                "cell_curtain_air_out_C": self.cell_curtain_air_out_c.tolist(),
             },
             "warnings": list(self.warnings),
         }
@@ -299,14 +381,37 @@ def _phase(exposure: FloatArray, capacities: FloatArray, accumulator: int) -> Fl
     return mat
 
 
+@dataclass(frozen=True)
+class _CurtainStream:
+    """The curtain of one cell and the air that crosses it (module notes)."""
+
+    particle_rate: float  #: particles falling through the cell's curtain per second
+    gas_capacity_rate_w_k: float  #: through-curtain air of the cell, mass flow x c_p
+    rows: int
+
+
 def _cell_matrix(model: SphereConduction, h_fall: float, h_bed: float, fall_time: float,
-                 bed_time: float, cycles: float) -> FloatArray:
-    """Map of a particle's state over one cell: ``cycles`` of (bed/2, fall, bed/2)."""
+                 bed_time: float, cycles: float,
+                 curtain: _CurtainStream | None = None) -> FloatArray:
+    """Map of a particle's state over one cell: ``cycles`` of (bed/2, fall, bed/2).
+
+    Without ``curtain`` a fall exposes the particle to the cell's air itself (all the air meets
+    the curtain); with it, a fall is one pass through the curtain model crossed by the
+    through-curtain stream entering at the cell's air temperature.
+    """
     n = model.shells
     caps = model.capacities
 
+    def fall_exposure(fraction: float) -> FloatArray:
+        if curtain is None:
+            return exposure_matrix(model, h_fall, fraction * fall_time)
+        # A part-cycle is a shorter fall through a proportionally smaller share of the air:
+        # the air per particle-second of exposure, hence the curtain's saturation, is kept.
+        return curtain_pass(model, h_fall, fraction * fall_time, curtain.particle_rate,
+                            fraction * curtain.gas_capacity_rate_w_k, curtain.rows).matrix
+
     def cycle(fraction: float) -> FloatArray:
-        fall = _phase(exposure_matrix(model, h_fall, fraction * fall_time), caps, n + 1)
+        fall = _phase(fall_exposure(fraction), caps, n + 1)
         bed = _phase(exposure_matrix(model, h_bed, 0.5 * fraction * bed_time), caps, n + 2)
         return bed @ fall @ bed
 
@@ -428,6 +533,18 @@ def solve_drum(plant: PlantSpec, closures: SliceClosures, law: TransportLaw,
     if not opt.bed_exchange:
         bed_share = 0.0
     marcher = _CellMarch(plant, opt, model, sphere, rate, c_air, math.pi * plant.diameter_m * dz)
+    # The through-curtain stream of one cell (module notes, "Air through the curtains"): its
+    # volume is given at the air inlet temperature, so its mass flow is the same in every cell.
+    rho_in = AirState.at(plant.air_inlet_temperature_c, _PRESSURE_KPA).density
+    curtain_stream: _CurtainStream | None = None
+    curtain_air_kg_s_m = math.inf
+    if opt.curtain_air_m3_s_m is not None:
+        curtain_air_kg_s_m = rho_in * opt.curtain_air_m3_s_m
+        curtain_stream = _CurtainStream(
+            particle_rate=scaled.falling_mass_flow_kg_s_m * dz / sphere.mass,
+            gas_capacity_rate_w_k=curtain_air_kg_s_m * dz * plant.air_heat_capacity_j_kgk,
+            rows=opt.curtain_rows,
+        )
 
     def film(t_air: float) -> tuple[float, float]:
         air = AirState.at(t_air, _PRESSURE_KPA)
@@ -449,7 +566,7 @@ def solve_drum(plant: PlantSpec, closures: SliceClosures, law: TransportLaw,
         for i in range(cells):
             h_fall, h_surface = film(float(seen[i]))
             mat = _cell_matrix(model, h_fall, h_surface * bed_share, scaled.fall_time_s,
-                               bed_time, cycles)
+                               bed_time, cycles, curtain_stream)
             mats.append(mat)
             unit_state = np.zeros(n + 3)
             unit_state[n] = 1.0
@@ -471,6 +588,18 @@ def solve_drum(plant: PlantSpec, closures: SliceClosures, law: TransportLaw,
     solids_loss = c_solids * (plant.material_inlet_temperature_c - t_mo)
     air_gain = c_air * (air_faces[0] - plant.air_inlet_temperature_c)
     residual = (solids_loss - air_gain - wall) / solids_loss
+    # The through-curtain air leaving each cell's curtain: it carries the curtain's heat.
+    if curtain_stream is None or curtain_stream.gas_capacity_rate_w_k == 0.0:
+        curtain_out = seen.copy()
+    else:
+        curtain_out = seen + q_f / curtain_stream.gas_capacity_rate_w_k
+    solids_cell = 0.5 * (solids[1:] + solids[:-1])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        approach = np.where(solids_cell > seen,
+                            (curtain_out - seen) / (solids_cell - seen), np.nan)
+    weights = np.abs(q_f)
+    saturation = (float(np.sum(weights * np.nan_to_num(approach)) / weights.sum())
+                  if curtain_stream is not None and weights.sum() > 0 else math.nan)
     warnings: list[str] = []
     if change >= 1e-6:
         warnings.append(f"air properties did not settle: last change {change:.2g} K")
@@ -497,6 +626,9 @@ def solve_drum(plant: PlantSpec, closures: SliceClosures, law: TransportLaw,
         biot_fall=sphere.biot(h_fall),
         energy_residual=residual,
         property_iterations=iterations,
+        curtain_air_kg_s_m=curtain_air_kg_s_m,
+        cell_curtain_air_out_c=curtain_out,
+        curtain_saturation=saturation,
         warnings=warnings,
     )
 
@@ -543,9 +675,14 @@ def paper_exchanger(plant: PlantSpec) -> ExchangerResult:
     return solve_outlet_temperature(h_w_m2k=60.15, area_m2=1099.28, **plant.streams())
 
 
-#: McCormick's volumetric coefficient for flighted rotary dryers as given in Perry's Chemical
-#: Engineers' Handbook (rotary dryers): Ua = K G^0.67 / D in Btu/(h ft^3 F), G in lb/(h ft^2),
-#: D in ft, with K = 0.5 for typical flighting.
+#: Handbook volumetric coefficient of flighted rotary dryers: Ua = K G^0.67 / D in
+#: Btu/(h ft^3 F), G in lb/(h ft^2), D in ft, K = 0.5; attributed to McCormick (1962) through
+#: Perry's Chemical Engineers' Handbook (rotary dryers). In SI it is 237 G^0.67 / D, W/(m^3 K),
+#: G in kg/(s m^2), D in m. Issue 34 checked it against a source it could read: Coulson and
+#: Richardson's Chemical Engineering Vol. 2, chapter 16 (Drying), Example 16.5, sizes a rotary
+#: dryer with L = Q / (0.0625 pi D G^0.67 dT_m) (as transcribed in FOSSEE's Scilab textbook
+#: companion, FOSSEE/Scilab-TBC-Uploads 542/CH16/EX16.5), i.e. Ua = 0.25 G^0.67 / D kW/(m^3 K):
+#: 250 against 237, 5 % apart, the same law. The Perry's page itself was not found to quote.
 VOLUMETRIC_K = 0.5
 _BTU_H_FT3_F = 18.6259  # W/(m^3 K)
 

@@ -20,7 +20,14 @@ energy balance closes to round-off.
 The plant measures the mixed air leaving both sections after the hood, which loses heat to
 the surroundings: hLosses A (T_air - T_amb) (the source's eqs. 23-25), solved implicitly for
 the measured temperature. f_c and hLosses A are the model's two fitted parameters
-(:mod:`drumflow.coolers.fit`); the source's values are 0.30 and 1.17 kW/K.
+(:mod:`drumflow.coolers.fit`); the source's values are 0.30 and 1.17 kW/K. The source's f_c
+multiplies another Nusselt correlation (Pakowski et al. 1984, not retrievable) than the one
+used here (Gunn 1978), so it does not carry over; the source's plant data are not published,
+so it cannot be refitted here either (issue 34): the case keeps 0.30 and says so.
+
+The bed (issue 34): dense phase at minimum fluidisation, bubble fraction of Johnsson et al.
+(1991); see :mod:`drumflow.coolers._fluidization` for why not the source's Richardson-Zaki
+dense phase, and where a vibrated, shallow Geldart D bed stands.
 
 Units: SI and kelvin inside; case fields in degC say so in their names.
 """
@@ -45,8 +52,10 @@ from drumflow.coolers.particle_interior import Sphere, SphereConduction
 from drumflow.coolers.refrigeration import (
     AirCooling,
     CycleResult,
+    SourceCycleCheck,
     air_cooling_duty,
     solve_cycle,
+    source_table_cycles,
 )
 from drumflow.errors import CaseError
 
@@ -100,6 +109,9 @@ class Product(_Section):
     density: float = Field(gt=100, le=10000, description="particle (granule) density, kg/m^3")
     heat_capacity: float = Field(gt=100, le=10000, description="specific heat, J/(kg K)")
     conductivity: float = Field(gt=0.01, le=100, description="thermal conductivity, W/(m K)")
+    min_fluidization_voidage: float | None = Field(
+        None, ge=0.35, le=0.6, description="voidage at minimum fluidisation (the dense phase); "
+        "default: Wen and Yu's 14^(-1/3) = 0.415 for spheres")
 
     @model_validator(mode="after")
     def _one_size(self) -> Product:
@@ -235,9 +247,10 @@ def check_fluidization(case: FluidBedCase, source: Path | str | None = None) -> 
                                          case.air.pressure_kPa * 1e3, case.air.ambient.relative_humidity))
     d, rho = case.product.diameter, case.product.density
     group = fl.geldart_group(d, rho, gas.density)
-    if group not in fl.VISIBLE_BUBBLE_FLOW_RATIO:
+    if group not in fl.BUBBLING_GROUPS:
         problems.append(f"product.sauter_diameter = {d:.4g} m with density {rho:g} kg/m^3 is "
-                        f"Geldart group {group}; allowed: groups B and D (bubble correlations)")
+                        f"Geldart group {group}; allowed: groups B and D (bed expansion of "
+                        "Johnsson et al. 1991)")
     else:
         u_mf = fl.minimum_fluidization_velocity(d, rho, gas)
         u_t = fl.terminal_velocity(d, rho, gas)
@@ -489,7 +502,8 @@ def run_unit(case: FluidBedCase, conditions: Conditions, *, convective_efficienc
             w_air = min(conditions.humidity_ratio, fl.saturation_humidity_ratio(chilled, p))
         gas = fl.humid_air(t_air, p, w_air)
         bed = fl.bed_state(velocity, gas, prod.diameter, prod.density, prod.mass_flow,
-                           unit.solids_velocity, unit.width, orifice_area)
+                           unit.solids_velocity, unit.width, orifice_area,
+                           prod.min_fluidization_voidage)
         re = fl.particle_reynolds(velocity, prod.diameter, gas)
         nu = fl.gunn_nusselt(re, gas.prandtl, bed.voidage)
         h = nu * gas.conductivity / prod.diameter
@@ -603,6 +617,7 @@ class Operation:
             "condensing_K": c.condensing_temperature if c else None,
             "discharge_K": c.discharge_temperature if c else None,
             "cop": c.cop if c else None,
+            "carnot_cop": c.carnot_cop if c else None,
             "energy_closure": self.unit.closure,
             "notes": self.notes,
         }
@@ -672,6 +687,18 @@ def operate_year(case: FluidBedCase, weather: list[MonthWeather] | None = None,
     return [(m, operate(case, month_conditions(case, m))) for m in table]
 
 
+def source_cycle_checks(case: FluidBedCase, weather: list[MonthWeather] | None = None,
+                        ) -> list[SourceCycleCheck]:
+    """The source's Table 1 re-solved with a consistent cycle (the case's compressor and
+    refrigerant), at the source's saturation temperatures and with condensing against the
+    month's river water plus the case's condenser approach (issue 34)."""
+    table = weather if weather is not None else load_weather(case.weather.table)
+    ref = case.refrigeration
+    river = {m.name: (ref.river_water_temperature_C if ref.river_water_temperature_C is not None
+                      else m.t_mean_C) + KELVIN + ref.condenser_approach_K for m in table}
+    return source_table_cycles(ref.polytropic_efficiency, ref.refrigerant, river)
+
+
 __all__ = ["Conditions", "FluidBedCase", "MonthWeather", "Operation", "SectionResult", "UnitResult",
            "case_conditions", "check_fluidization", "load_fluid_bed_case", "load_weather",
-           "month_conditions", "operate", "operate_year", "run_unit"]
+           "month_conditions", "operate", "operate_year", "run_unit", "source_cycle_checks"]

@@ -20,6 +20,23 @@ isentropic discharge enthalpy.
 
 The air side: humid air cooled from ambient to the cooled-air temperature; below its dew
 point water condenses and leaves at that temperature, so the duty includes the latent load.
+
+The source's Table 1 (issue 34). Its column headers were lost with the equations; the
+columns are read by their numbers: the condenser heat (col. 3) is minus the sum of the duty
+(col. 1) and the compressor work (col. 6) to 0.002 kJ/kg in each month, cols. 2 and 4 are
+kelvin (evaporating, then condensing: 275.80 K and 320.15 K in June), col. 5 is kg of
+ammonia per kg of product. Read so, its COP (duty / work) is above the Carnot COP
+T_e / (T_c - T_e) in all three months (June 6.23 against 6.22, July 5.44 against 5.35,
+August 5.50 against 5.41), which no cycle can reach: its compressor work is too small.
+Its numbers are reproduced by a cycle that (a) sizes the ammonia flow on the latent heat at
+the evaporating temperature, duty / h_fg(T_e) (0.0024028 kg/kg in June against the table's
+0.0024027), ignoring the vapour that flashes in the valve (h1 - h4 = h1 - h3 is 17-19 %
+smaller), and (b) compresses isentropically (work per kg of ammonia 201.0 kJ/kg in June,
+the isentrope's 201.0; July and August 1.2 % under it), not along the polytropic path with
+an efficiency the source's text describes. (a) alone puts the COP above Carnot.
+:func:`source_table_cycles` re-solves each month with this module's consistent cycle at the
+source's own duty and saturation temperatures (July: 2.88 kJ/kg of work at eta_p = 0.75,
+not 1.61), and, for comparison, with condensing against river water.
 """
 
 from __future__ import annotations
@@ -80,6 +97,14 @@ class CycleResult:
     condensing_temperature: float
     discharge_temperature: float
     states: tuple[CycleState, CycleState, CycleState, CycleState]
+
+
+def carnot_cop(evaporating_temperature: float, condensing_temperature: float) -> float:
+    """T_e / (T_c - T_e): the COP of a reversible cycle between the two temperatures (K)."""
+    if not 0.0 < evaporating_temperature < condensing_temperature:
+        raise ValueError(f"evaporating temperature {evaporating_temperature!r} K must be > 0 and "
+                         f"below the condensing temperature {condensing_temperature!r} K")
+    return evaporating_temperature / (condensing_temperature - evaporating_temperature)
 
 
 def _state(refrigerant: str, pressure: float, enthalpy: float) -> CycleState:
@@ -156,7 +181,7 @@ def solve_cycle(duty: float, evaporating_temperature: float, condensing_temperat
         condenser_heat=flow * (h2 - h3),
         refrigerant_flow=flow,
         cop=q_evap / w,
-        carnot_cop=evaporating_temperature / (condensing_temperature - evaporating_temperature),
+        carnot_cop=carnot_cop(evaporating_temperature, condensing_temperature),
         evaporating_temperature=evaporating_temperature,
         condensing_temperature=condensing_temperature,
         discharge_temperature=s2.temperature,
@@ -202,5 +227,111 @@ def air_cooling_duty(dry_air_flow: float, inlet_temperature: float, inlet_humidi
     return AirCooling(float(duty), float(w_out), float(condensate))
 
 
-__all__ = ["AirCooling", "CycleResult", "CycleState", "air_cooling_duty", "humidity_ratio",
-           "polytropic_discharge_enthalpy", "solve_cycle"]
+# == the source's Table 1 ======================================================================
+@dataclass(frozen=True)
+class SourceCycleRow:
+    """One month of the source's Table 1, per kg of fertiliser (columns read as in the module
+    docstring).
+
+    Attributes
+    ----------
+    month
+        June, July or August.
+    duty
+        Heat taken from the chilled side, kJ/kg (col. 1).
+    evaporating_temperature
+        K (col. 2).
+    condenser_heat
+        kJ/kg, negative: given to the river water (col. 3).
+    condensing_temperature
+        K (col. 4).
+    refrigerant_flow
+        kg ammonia / kg product (col. 5).
+    power
+        Compressor work, kJ/kg (col. 6).
+    """
+
+    month: str
+    duty: float
+    evaporating_temperature: float
+    condenser_heat: float
+    condensing_temperature: float
+    refrigerant_flow: float
+    power: float
+
+    @property
+    def cop(self) -> float:
+        return self.duty / self.power
+
+    @property
+    def carnot_cop(self) -> float:
+        return carnot_cop(self.evaporating_temperature, self.condensing_temperature)
+
+    @property
+    def exceeds_carnot(self) -> bool:
+        """True when the row's COP is above the reversible limit (the second law is broken)."""
+        return self.cop > self.carnot_cop
+
+
+#: The source's Table 1, transcribed (``/work/shared/reference/vibrating-fluid-bed-cooler.md``).
+SOURCE_TABLE_1: tuple[SourceCycleRow, ...] = (
+    SourceCycleRow("June", 3.009, 275.80, -3.494, 320.15, 0.00240273, 0.483),
+    SourceCycleRow("July", 8.768, 272.06, -10.380, 322.95, 0.00691682, 1.613),
+    SourceCycleRow("August", 8.339, 272.43, -9.856, 322.75, 0.00658318, 1.517),
+)
+
+
+@dataclass(frozen=True)
+class SourceCycleCheck:
+    """One month of the source's Table 1 beside consistent cycles at the same duty.
+
+    Attributes
+    ----------
+    row
+        The source's numbers.
+    at_source_temperatures
+        This module's cycle at the source's evaporating and condensing temperatures,
+        per kg of product (its ``duty``, ``power``, ``condenser_heat`` in J/kg and
+        ``refrigerant_flow`` in kg/kg).
+    with_river_condensing
+        The same at the source's evaporating temperature with condensing against river water
+        (None when no river temperature was given for the month).
+    """
+
+    row: SourceCycleRow
+    at_source_temperatures: CycleResult
+    with_river_condensing: CycleResult | None
+
+
+def source_table_cycles(polytropic_efficiency: float, refrigerant: str = "Ammonia",
+                        river_condensing: dict[str, float] | None = None,
+                        ) -> list[SourceCycleCheck]:
+    """Re-solve the source's Table 1 with a consistent cycle.
+
+    Parameters
+    ----------
+    polytropic_efficiency
+        Of the compressor (the source gives none; the case's).
+    refrigerant
+        A CoolProp fluid name (the source: ammonia).
+    river_condensing
+        Condensing temperature (K) against river water per month name, for the second
+        cycle; months missing from it get none.
+    """
+    out = []
+    for row in SOURCE_TABLE_1:
+        duty = row.duty * 1e3  # J per kg of product: the cycle's "per second" read per kg
+        at_source = solve_cycle(duty, row.evaporating_temperature, row.condensing_temperature,
+                                polytropic_efficiency, refrigerant)
+        t_river = (river_condensing or {}).get(row.month)
+        river = None
+        if t_river is not None:
+            river = solve_cycle(duty, row.evaporating_temperature, t_river,
+                                polytropic_efficiency, refrigerant)
+        out.append(SourceCycleCheck(row, at_source, river))
+    return out
+
+
+__all__ = ["SOURCE_TABLE_1", "AirCooling", "CycleResult", "CycleState", "SourceCycleCheck",
+           "SourceCycleRow", "air_cooling_duty", "carnot_cop", "humidity_ratio",
+           "polytropic_discharge_enthalpy", "solve_cycle", "source_table_cycles"]

@@ -18,6 +18,7 @@ from drumflow.dem.conduction import liggghts_conductivity
 from drumflow.dem.restitution import calibrate_case
 from drumflow.dem.stability import CHECK_EVERY_STEPS
 from drumflow.dem.timestep import TimeStepChoice
+from drumflow.errors import GeometryError
 
 if TYPE_CHECKING:
     from drumflow.case import Case
@@ -67,6 +68,8 @@ class DeckFiles:
     final_restart: str = "restart/drum.*.restart"
     #: A start state's particle temperatures (``variable atomfile``, drumflow.dem.state).
     start_temperatures: str = "start_temperatures.txt"
+    #: The end plates turning with the shell (``drum.ends = "rotating"``); "" = none.
+    ends_stl_file: str = ""
 
 
 @dataclass(frozen=True)
@@ -217,6 +220,9 @@ def deck_context(
     """
     p = case.particles
     cc = case.contacts
+    if case.drum.ends == "rotating" and not files.ends_stl_file:
+        raise GeometryError("drum.ends = 'rotating' needs the end plates' STL (DeckFiles.ends_stl_file, "
+                         "written by the geometry stage)")
     restitution = calibrate_case(case, plan.time_step)
     E_wall = cc.wall_youngs_modulus if cc.wall_youngs_modulus is not None else p.youngs_modulus
     return {
@@ -264,6 +270,8 @@ def deck_context(
         "stl_file": files.stl_file,
         "lifters_stl_file": files.lifters_stl_file,
         "static_shell": files.static_shell,
+        "ends": case.drum.ends,
+        "ends_stl_file": files.ends_stl_file,
         "omega": f"{case.drum.omega:.9g}",
         "length": f"{case.drum.length:.9g}",
         "period": f"{60.0 / case.drum.rpm:.9g}",

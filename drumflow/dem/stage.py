@@ -370,6 +370,7 @@ def write_deck(case: Case, rundir: RunDir, inputs: DemInputs,
         stl_file=str(Path("..") / geometry.stl),
         lifters_stl_file=str(Path("..") / geometry.lifters_stl) if geometry.lifters_stl else "",
         static_shell=geometry.wall_motion == "static_shell",
+        ends_stl_file=str(Path("..") / geometry.ends_stl) if geometry.ends_stl else "",
     )
     context = deck_context(
         case,

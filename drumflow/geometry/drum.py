@@ -9,6 +9,12 @@ in the section. Planes are exact and cost no mesh contacts; an axially periodic 
 instead need the mesh to cross the periodic boundary, which LIGGGHTS' mesh walls handle poorly,
 and would let the tilt drive an endless axial drift that the paper's closed section does not
 have.
+
+``drum.ends`` chooses otherwise: ``"rotating"`` closes the section with two flat disks that turn
+with the shell (:func:`build_end_mesh`; a disk turning about its own axis is the same surface at
+every instant, so LIGGGHTS keeps it in place with the shell's surface velocity), as a real drum's
+end walls do; ``"periodic"`` has no end walls and a box periodic along z over exactly the section
+length (:func:`simulation_box`), the middle of a long drum.
 """
 
 from __future__ import annotations
@@ -67,10 +73,14 @@ def simulation_box(case: Case) -> SimulationBox:
     """A box hugging the drum with a margin of two particle diameters.
 
     A tight box means a particle that leaks through the shell leaves the box within a few
-    steps and is counted as lost, instead of falling unseen outside the drum.
+    steps and is counted as lost, instead of falling unseen outside the drum. With
+    ``drum.ends = "periodic"`` the box spans exactly the section along z (0 to the length): its
+    period is the section length, and the walls end on its faces.
     """
     R = case.drum.radius
     m = max(2.0 * case.particles.diameter, 0.01 * R)
+    if case.drum.ends == "periodic":
+        return SimulationBox((-R - m, -R - m, 0.0), (R + m, R + m, case.drum.length))
     return SimulationBox((-R - m, -R - m, -m), (R + m, R + m, case.drum.length + m))
 
 
@@ -165,6 +175,23 @@ def build_wall_mesh(case: Case, size: float | None = None, with_lifters: bool = 
     with_lifters
         ``False``: the bare cylinder (the static shell of ``run.wall_motion = "static_shell"``).
     """
+    return _mesh_section(case, size, with_lifters, ("walls",))
+
+
+def build_end_mesh(case: Case, size: float | None = None) -> WallMesh:
+    """Triangulate the two end plates of the section (``drum.ends = "rotating"``): full disks of
+    the shell's radius at z = 0 and z = length.
+
+    Full disks, not the cross-section between the lifters: the plates turn with the shell but
+    stay in place in LIGGGHTS (surface velocity), so holes cut where the lifters stand at t = 0
+    would be open once the lifters have moved on. The lifters' open ends touch the disks.
+    """
+    return _mesh_section(case, size, False, ("inlet", "outlet"))
+
+
+def _mesh_section(case: Case, size: float | None, with_lifters: bool,
+                  parts: tuple[str, ...]) -> WallMesh:
+    """The surfaces ``parts`` ("walls", "inlet", "outlet") of the extruded section as one mesh."""
     import gmsh
 
     size = facet_size(case) if size is None else size
@@ -175,8 +202,9 @@ def build_wall_mesh(case: Case, size: float | None = None, with_lifters: bool = 
         gmsh.model.occ.extrude([(2, surface)], 0.0, 0.0, length)
         gmsh.model.occ.synchronize()
         groups = _classify_surfaces(length, 1e-6 * max(length, 1.0))
-        if not groups["walls"]:
-            raise GeometryError("gmsh produced no wall surfaces for the drum")
+        wanted = [tag for part in parts for tag in groups[part]]
+        if not groups["walls"] or not wanted:
+            raise GeometryError(f"gmsh produced no {' or '.join(parts)} surfaces for the drum")
         gmsh.option.setNumber("Mesh.MeshSizeMax", size)
         gmsh.option.setNumber("Mesh.MeshSizeMin", 0.2 * size)
         gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 36)
@@ -187,7 +215,7 @@ def build_wall_mesh(case: Case, size: float | None = None, with_lifters: bool = 
         index[node_tags.astype(np.int64)] = np.arange(len(node_tags))
         points = coords.reshape(-1, 3)
         tris: list[NDArray[np.int64]] = []
-        for tag in groups["walls"]:
+        for tag in wanted:
             etypes, _, enodes = gmsh.model.mesh.getElements(2, tag)
             for etype, nodes in zip(etypes, enodes, strict=True):
                 if etype != 2:  # 3-node triangles only; anything else means a bad mesh
@@ -218,13 +246,15 @@ def lifter_part(mesh: WallMesh, radius: float) -> WallMesh:
     return WallMesh(mesh.points[used].copy(), remap[triangles])
 
 
-def check_wall_mesh(mesh: WallMesh, case: Case, open_at_shell: bool = False) -> dict[str, float | int]:
+def check_wall_mesh(mesh: WallMesh, case: Case, open_at_shell: bool = False,
+                    open_edges: bool = False) -> dict[str, float | int]:
     """Check the wall mesh before LIGGGHTS sees it; return its statistics.
 
     Checks: no degenerate triangles (area or smallest angle); every edge shared by exactly two
     triangles except the open rims at the two end planes (the shell is closed around the
     circumference and along the lifters); every point inside the simulation box.
     ``open_at_shell``: the lifters alone, open also where their feet meet the shell.
+    ``open_edges``: flat end plates, whose rims are open by nature (edges are not checked).
 
     Raises
     ------
@@ -251,13 +281,15 @@ def check_wall_mesh(mesh: WallMesh, case: Case, open_at_shell: bool = False) -> 
     uniq, counts = np.unique(e, axis=0, return_counts=True)
     if (counts > 2).any():
         raise GeometryError(f"{int((counts > 2).sum())} non-manifold edges in the walls")
-    open_edges = uniq[counts == 1]
+    rim_edges = uniq[counts == 1]
     length = case.drum.length
     tol = 1e-6 * max(length, 1.0)
-    z = p[open_edges][:, :, 2]
+    z = p[rim_edges][:, :, 2]
     on_rim = ((np.abs(z) < tol) | (np.abs(z - length) < tol)).all(axis=1)
     if open_at_shell:
-        on_rim |= _on_shell(p[open_edges], case.drum.radius).all(axis=1)
+        on_rim |= _on_shell(p[rim_edges], case.drum.radius).all(axis=1)
+    if open_edges:
+        on_rim[:] = True
     if not on_rim.all():
         raise GeometryError(
             f"the walls are open along {int((~on_rim).sum())} edges away from the end planes"
@@ -268,7 +300,7 @@ def check_wall_mesh(mesh: WallMesh, case: Case, open_at_shell: bool = False) -> 
     return {
         "triangles": int(len(t)),
         "points": int(len(p)),
-        "open_rim_edges": int(len(open_edges)),
+        "open_rim_edges": int(len(rim_edges)),
         "min_quality": float(quality.min()),
         "max_edge_m": float(longest.max()),
         "wall_area_m2": float(area.sum()),

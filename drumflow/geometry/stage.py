@@ -12,6 +12,7 @@ from dataclasses import asdict, dataclass
 from typing import TYPE_CHECKING
 
 from drumflow.geometry.drum import (
+    build_end_mesh,
     build_wall_mesh,
     check_wall_mesh,
     facet_size,
@@ -48,6 +49,8 @@ class GeometryResult:
     wall_motion: str = "moving_mesh"
     lifters_stl: str | None = None  # static_shell only: the lifters, the one moving mesh
     lifters_stl_sha256: str | None = None
+    ends_stl: str | None = None  # drum.ends = "rotating" only: the two end plates
+    ends_stl_sha256: str | None = None
 
 
 def wall_motion(case: Case) -> str:
@@ -63,7 +66,8 @@ def wall_motion(case: Case) -> str:
 
 def geometry_key(case: Case) -> str:
     """What the geometry depends on: drum, lifters, (through 'auto' facets) particle size, and
-    the wall representation."""
+    the wall representation (``drum.ends`` through the drum section, left out at "fixed" so
+    that geometry made before it existed is reused)."""
     return case.section_hash("drum", "lifters") + f":{facet_size(case):.9g}:{wall_motion(case)}"
 
 
@@ -71,7 +75,8 @@ def _reusable(done: dict | None, rundir: RunDir) -> bool:
     if not done:
         return False
     r = done["result"]
-    for name, sha in (("stl", "stl_sha256"), ("lifters_stl", "lifters_stl_sha256")):
+    for name, sha in (("stl", "stl_sha256"), ("lifters_stl", "lifters_stl_sha256"),
+                      ("ends_stl", "ends_stl_sha256")):
         if r.get(name) is None:
             continue
         path = rundir.root / r[name]
@@ -116,6 +121,15 @@ def build_geometry(case: Case, rundir: RunDir) -> GeometryResult:
     else:
         stl = rundir.geometry / "walls.stl"
         write_ascii_stl(walls, stl)
+    ends_rel = ends_sha = None
+    if case.drum.ends == "rotating":
+        ends = build_end_mesh(case)
+        check_wall_mesh(ends, case, open_edges=True)
+        ends_stl = rundir.geometry / "ends.stl"
+        write_ascii_stl(ends, ends_stl)
+        ends_rel = str(ends_stl.relative_to(rundir.root))
+        ends_sha = file_hash(ends_stl)
+        stats["triangles"] = int(stats["triangles"]) + len(ends.triangles)
     plot_cross_section(case, rundir.geometry_picture)
     box = simulation_box(case)
     result = GeometryResult(
@@ -130,6 +144,8 @@ def build_geometry(case: Case, rundir: RunDir) -> GeometryResult:
         wall_motion=motion,
         lifters_stl=lifters_rel,
         lifters_stl_sha256=lifters_sha,
+        ends_stl=ends_rel,
+        ends_stl_sha256=ends_sha,
     )
     rundir.geometry_json.write_text(json.dumps(asdict(result), indent=2))
     rundir.mark_done("geometry", key, asdict(result), time.perf_counter() - t0)

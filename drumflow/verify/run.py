@@ -24,6 +24,7 @@ from drumflow.verify.contacts import (
     wall_restitution_check,
 )
 from drumflow.verify.interior import BIOTS, interior_series_check
+from drumflow.verify.porous_bed import porous_bed_checks
 from drumflow.verify.references import air_property_checks, drag_curve_check
 from drumflow.verify.single_particle import (
     SETTLING_DIAMETERS,
@@ -76,6 +77,8 @@ def verification_steps(out: Path, runner: Runner, quick: bool) -> list[Callable[
         lambda: [wall_restitution_check(out / "wall_restitution_0.3", runner, restitution=0.3)],
     ]
     if not quick:
+        # A LIGGGHTS-packed bed (1-3 min to pour) with porousSimpleFoam through and past it.
+        steps.append(lambda: porous_bed_checks(out / "porous_bed", runner))
         steps.append(lambda: coupling_interval_sweep(out / "interval_sweep", runner))
         steps.append(lambda: [pipe_friction_check(out / "pipe_friction", runner)])
         # The paper's soft 517 kPa particles, and the restitution at a slower impact (1 m/s).

@@ -33,10 +33,11 @@ import test_laws_curtain as laws_curtain  # noqa: E402
 import test_laws_drum as laws_drum  # noqa: E402
 import test_laws_fluid_bed as laws_fluid_bed  # noqa: E402
 import test_laws_grate as laws_grate  # noqa: E402
+import test_laws_refrigeration as laws_refrigeration  # noqa: E402
 
 from drumflow import air_properties  # noqa: E402
 from drumflow.analysis import predict  # noqa: E402
-from drumflow.coolers import _fluidization, curtain, drum  # noqa: E402
+from drumflow.coolers import _fluidization, curtain, drum, refrigeration  # noqa: E402
 from drumflow.coolers.grate import model as grate_model  # noqa: E402
 from drumflow.coolers.grate import properties as grate_props  # noqa: E402
 from drumflow.coupling import physics  # noqa: E402
@@ -161,6 +162,33 @@ MUTANTS: tuple[Mutant, ...] = (
     Mutant("fluid-bed h x1.1",
            lambda mp: scale_function(mp, _fluidization, "gunn_nusselt", 1.1),
            laws_fluid_bed.check_lumped_sections),
+    # Issue 34: the bed's expansion and the source's Table 1.
+    Mutant("fluid-bed Johnsson 1.3 -> 1.43",
+           lambda mp: mutate_source(mp, _fluidization, "johnsson_bubble_fraction",
+                                    "1.3 / f", "1.43 / f"),
+           laws_fluid_bed.check_bed_expansion),
+    Mutant("fluid-bed Johnsson exponent -0.8 -> -0.88",
+           lambda mp: mutate_source(mp, _fluidization, "johnsson_bubble_fraction",
+                                    "excess_velocity**-0.8", "excess_velocity**-0.88"),
+           laws_fluid_bed.check_bed_expansion),
+    Mutant("fluid-bed Johnsson size term 0.26 -> 0.286",
+           lambda mp: mutate_source(mp, _fluidization, "johnsson_bubble_fraction",
+                                    "0.26 + 0.70 * math", "0.286 + 0.70 * math"),
+           laws_fluid_bed.check_bed_expansion),
+    Mutant("fluid-bed eps_mf Wen-Yu 14 -> 15.4",
+           lambda mp: mp.setattr(_fluidization, "WEN_YU_INERTIAL", 15.4),
+           laws_fluid_bed.check_bed_expansion),
+    Mutant("fluid-bed bed height x1.1",
+           lambda mp: mutate_source(mp, _fluidization, "bed_state", "height = solids_flow / (",
+                                    "height = 1.1 * solids_flow / ("),
+           laws_fluid_bed.check_bed_expansion),
+    Mutant("Carnot COP x1.1",
+           lambda mp: scale_function(mp, refrigeration, "carnot_cop", 1.1),
+           laws_refrigeration.check_source_table_1),
+    Mutant("source Table 1 cycle duty x1.1",
+           lambda mp: mutate_source(mp, refrigeration, "source_table_cycles",
+                                    "duty = row.duty * 1e3", "duty = row.duty * 1.1e3"),
+           laws_refrigeration.check_source_table_1),
     Mutant("coupling drag x1.1",
            lambda mp: scale_function(mp, physics, "drag_force", 1.1),
            laws_coupling.check_drag),

@@ -11,6 +11,10 @@ wrong h. Independent references here:
   Gunn's Nu k / d, with the gas properties taken straight from CoolProp's HAPropsSI and the
   bed voidage from the model's hydrodynamics (an input to the heat law, not part of it).
 
+* the bed's expansion (issue 34) at one point worked out by hand: Wen and Yu's u_mf and
+  eps_mf, Johnsson et al.'s (1991) bubble fraction, the two-phase voidage and the bed height
+  that holds the solids.
+
 Each ``check_*`` is a plain function (see ``test_law_mutants.py``) that calls the package
 through its modules, so that a patched law is the one checked.
 """
@@ -47,6 +51,32 @@ def check_gunn_nusselt() -> None:
     nu_hand = (2.8 * (1.0 + 0.7 * 100.0**0.2 * pr3) + 0.322 * 100.0**0.7 * pr3)
     assert abs(nu_hand - 14.40778) < 1e-4
     _close(fl.gunn_nusselt(100.0, 0.71, 0.6), nu_hand, 1e-9, "Gunn Nusselt number")
+
+
+def check_bed_expansion() -> None:
+    """Section C of the case at a gas of round properties (rho_g = 1.2 kg/m^3, mu = 1.8e-5 Pa s):
+    2.7 mm granules of 1750 kg/m^3 at 7.5 m/s, S = 13.88889 kg/s, v = 0.2 m/s, B = 1 m.
+
+    Wen and Yu (1966): Ar = 1.2 * 1748.8 * 9.81 * (2.7e-3)^3 / (1.8e-5)^2 = 1 250 652.6,
+    Re_mf = sqrt(33.7^2 + 0.0408 Ar) - 33.7 = 194.6907, u_mf = Re_mf mu / (rho d) = 1.081615 m/s;
+    eps_mf = 14^(-1/3) = 0.4149133.
+    Johnsson et al. (1991): u - u_mf = 6.418385 m/s; f = (0.26 + 0.70 e^(-3.3 * 2.7))
+    (0.15 + 6.418385)^-0.33 = 0.2600945 * 0.5373270 = 0.1397558; 1.3 / f * 6.418385^-0.8
+    = 9.301998 * 0.2259745 = 2.102001; delta_b = 1 / 3.102001 = 0.3223726.
+    Voidage 0.3223726 + 0.6776274 * 0.4149133 = 0.6035292 (the old Richardson-Zaki bed: 0.989);
+    height 13.88889 / (0.2 * 1 * 1750 * 0.3964708) = 0.1000894 m (old: 3.63 m).
+    Exact arithmetic both sides: 1e-6 (the typed values carry 7 digits); a 10 % change of
+    Johnsson's 1.3 moves the voidage by 1.8 % and the height by 2.7 %.
+    """
+    gas = fl.HumidAir(temperature=293.15, pressure=101325.0, humidity_ratio=0.0, density=1.2,
+                      heat_capacity=1006.0, viscosity=1.8e-5, conductivity=0.026)
+    bed = fl.bed_state(7.5, gas, 2.7e-3, 1750.0, solids_flow=13.88889, solids_velocity=0.2,
+                       width=1.0, orifice_area=4e-4)
+    _close(bed.min_fluidization_velocity, 1.081615, 1e-6, "u_mf (Wen and Yu)")
+    _close(bed.dense_phase_voidage, 0.4149133, 1e-6, "eps_mf = 14^(-1/3)")
+    _close(bed.bubble_fraction, 0.3223726, 1e-6, "bubble fraction (Johnsson et al. 1991)")
+    _close(bed.voidage, 0.6035292, 1e-6, "bed voidage")
+    _close(bed.bed_height, 0.1000894, 1e-6, "bed height")
 
 
 def _lumped_case() -> fb.FluidBedCase:
@@ -105,3 +135,7 @@ def test_gunn_nusselt_by_hand() -> None:
 
 def test_lumped_deck_in_closed_form() -> None:
     check_lumped_sections()
+
+
+def test_bed_expansion_by_hand() -> None:
+    check_bed_expansion()

@@ -4,6 +4,7 @@ Ranade 2005).
 
 - :mod:`~drumflow.coolers.grate.case`: the validated TOML case.
 - :mod:`~drumflow.coolers.grate.properties`: hot air, clinker and the packed-bed correlation.
+- :mod:`~drumflow.coolers.grate.fans`: air flow limited by the bed (Ergun against a fan curve).
 - :mod:`~drumflow.coolers.grate.tdma`: the tri-diagonal line solver.
 - :mod:`~drumflow.coolers.grate.model`: balance cells, boundary conditions, sweeps.
 - :mod:`~drumflow.coolers.grate.studies`: parameter and grid studies.

@@ -11,7 +11,8 @@ Layout::
     [clinker]   mass_flow, inlet_temperature, particle_diameter, sphericity, bed_porosity,
                 density, heat_capacity, heat_capacity_slope, conductivity,
                 conductivity_slope, emissivity
-    [air]       mass_flow, inlet_temperature, distribution
+    [air]       mass_flow, inlet_temperature, distribution, supply
+    [fan]       shutoff_pressure, free_delivery        (only with air.supply = "fan")
     [model]     radiation, interior_resistance
     [numerics]  cells_length, cells_height, exchange, under_relaxation,
                 residual_tolerance, energy_tolerance, max_sweeps
@@ -28,7 +29,7 @@ from drumflow.case import INPUT_MODEL_CONFIG, read_toml, validate_model
 from drumflow.coolers.grate.properties import AIR_T_MAX, AIR_T_MIN
 
 __all__ = [
-    "Air", "Clinker", "Cooler", "GrateCase", "Model", "Numerics", "grate_case_from_dict",
+    "Air", "Clinker", "Cooler", "Fan", "GrateCase", "Model", "Numerics", "grate_case_from_dict",
     "load_grate_case",
 ]
 
@@ -99,6 +100,11 @@ class Air(_Section):
         "(normalised; [1.0] = uniform, the report's Eq. 16)",
     )
 
+    supply: Literal["fixed", "fan"] = Field(
+        "fixed", description="'fixed': mass_flow is blown whatever the bed's resistance (the "
+        "report); 'fan': the [fan] curve against the bed's Ergun pressure drop sets the flow, "
+        "and mass_flow is only the first guess of the operating point")
+
     @model_validator(mode="after")
     def _positive_weights(self) -> Air:
         bad = [f"air.distribution[{i}] = {w}: must be > 0 (a compartment without air leaves "
@@ -107,6 +113,23 @@ class Air(_Section):
         if bad:
             raise ValueError("\n".join(bad))
         return self
+
+
+class Fan(_Section):
+    """The cooling-air fan(s) as one pressure-flow curve (used with ``air.supply = "fan"``).
+
+    Delta p_fan(Q) = shutoff_pressure [1 - (Q / free_delivery)^2], Q the volume flow at the
+    air inlet temperature and 1 atm (a fan moves a volume at its speed); without
+    free_delivery the curve is flat, a fixed fan pressure. The air shares of the compartments
+    stay air.distribution (dampers hold them); the fan's pressure rise is the flow-weighted
+    mean of the columns' bed pressure drops (see :mod:`drumflow.coolers.grate.fans`).
+    """
+
+    shutoff_pressure: float = Field(gt=0, le=50_000,
+                                    description="fan pressure rise at zero flow, Pa")
+    free_delivery: float | None = Field(
+        None, gt=0, le=10_000, description="volume flow at zero pressure rise, m3/s at the air "
+        "inlet temperature and 1 atm (omitted: a flat curve, the fixed fan pressure)")
 
 
 class Model(_Section):
@@ -144,6 +167,7 @@ class GrateCase(_Section):
     cooler: Cooler
     clinker: Clinker
     air: Air
+    fan: Fan | None = None
     model: Model = Field(default_factory=Model)
     numerics: Numerics = Field(default_factory=Numerics)
 
@@ -163,6 +187,12 @@ class GrateCase(_Section):
                 problems.append(
                     f"clinker.{field}_slope = {slope}: makes clinker.{field} {low_end:.4g} <= 0 "
                     f"between {lo:g} K and {hi:g} K; allowed: positive over that range")
+        if a.supply == "fan" and self.fan is None:
+            problems.append("air.supply = 'fan': needs a [fan] section (shutoff_pressure, "
+                            "optional free_delivery)")
+        if a.supply == "fixed" and self.fan is not None:
+            problems.append("[fan] given with air.supply = 'fixed', which would ignore it; "
+                            "allowed: air.supply = 'fan' with [fan], or no [fan]")
         problems += _size_problems(self.numerics)
         if problems:
             raise ValueError("\n".join(problems))

@@ -79,6 +79,15 @@ Solution
     heat duty m_s [h_s(T_in) - h_s(T_air,in)], and the global energy imbalance are both
     below the case's tolerances (1e-9 in the shipped case).
 
+Fan-limited air
+    With ``air.supply = "fan"`` the air flow is not given but set where the fan curve meets
+    the bed's Ergun pressure drop (:mod:`drumflow.coolers.grate.fans`): after every sweep the
+    total air flow is moved to the operating point at the sweep's air temperatures, and the
+    solve stops when, besides the two tolerances above, that flow changes by less than
+    ``numerics.residual_tolerance`` relative. ``numerics.max_sweeps`` bounds the whole solve,
+    the air-flow iteration included (the same sweeps, no outer loop). The solution's case
+    holds the operating point as ``air.mass_flow``.
+
 Runtime
     Measured in ``docs/grate/runtime.csv`` (written by ``scripts/grate_studies.py``).
 """
@@ -94,6 +103,12 @@ import numpy as np
 from numpy.typing import NDArray
 
 from drumflow.coolers.grate.case import GrateCase
+from drumflow.coolers.grate.fans import (
+    bed_resistance,
+    column_pressure_drops,
+    fan_pressure,
+    operating_point,
+)
 from drumflow.coolers.grate.properties import (
     AIR_T_MAX,
     AIR_T_MIN,
@@ -243,10 +258,40 @@ class GrateSolution:
         top = self.clinker_temperature[-1]
         return float(np.sum(c_rad * (top**4 - self.freeboard_temperature**4)))
 
+    @property
+    def air_flow(self) -> float:
+        """Total cooling-air mass flow, kg/s (the operating point with ``air.supply = "fan"``)."""
+        return self.case.air.mass_flow
+
+    @property
+    def column_pressure_drop(self) -> FloatArray:
+        """Ergun pressure drop across the bed of every column, Pa."""
+        return column_pressure_drops(self.case, self.air_temperature, self.air_column_flow,
+                                     self.bed_height)
+
+    @property
+    def bed_pressure_drop(self) -> float:
+        """Flow-weighted mean of the columns' bed pressure drops, Pa (what the fan sees)."""
+        shares = self.air_column_flow / self.air_column_flow.sum()
+        return float(np.sum(shares * self.column_pressure_drop))
+
+    @property
+    def fan_pressure(self) -> float | None:
+        """Pressure rise of the fan curve at the air flow, Pa (None for a given air flow)."""
+        fan = self.case.fan
+        if self.case.air.supply != "fan" or fan is None:
+            return None
+        return fan_pressure(fan, self.air_flow, self.case.air.inlet_temperature)
+
     def summary(self) -> dict[str, Any]:
         """Headline numbers (JSON-ready)."""
         n, m = self.x.size, self.y.size
+        fan_p = self.fan_pressure
         return {
+            "air_supply": self.case.air.supply,
+            "air_flow_kg_s": self.air_flow,
+            "bed_pressure_drop_Pa": self.bed_pressure_drop,
+            **({} if fan_p is None else {"fan_pressure_Pa": fan_p}),
             "clinker_outlet_temperature_K": self.clinker_outlet_temperature,
             "secondary_air_temperature_K": self.secondary_air_temperature,
             "heat_recovered_MW": self.heat_recovered / 1e6,
@@ -275,13 +320,15 @@ def _radiation_conductance(case: GrateCase, n: int) -> float:
     return STEFAN_BOLTZMANN * c.emissivity * (1.0 - c.bed_porosity) * dx * case.cooler.width
 
 
-def _air_column_flow(case: GrateCase, n: int) -> FloatArray:
-    """Air mass flow through each column of cells, kg/s (compartment weights, kiln end first)."""
+def _air_column_flow(case: GrateCase, n: int, air_flow: float | None = None) -> FloatArray:
+    """Air mass flow through each column of cells, kg/s (compartment weights, kiln end first),
+    for the case's total air flow or ``air_flow``."""
     weights = np.asarray(case.air.distribution, dtype=np.float64)
     x_centre = (np.arange(n) + 0.5) / n  # fraction of the grate length
     compartment = np.minimum((x_centre * weights.size).astype(int), weights.size - 1)
     w = weights[compartment]
-    return case.air.mass_flow * w / w.sum()
+    total = case.air.mass_flow if air_flow is None else air_flow
+    return total * w / w.sum()
 
 
 class _Grid:
@@ -297,10 +344,7 @@ class _Grid:
         self.width = cooler.width
         self.volume = self.dx * self.dy * self.width
         self.layer_flow = c.mass_flow / self.m  # Eq. (1)
-        self.column_flow = _air_column_flow(case, self.n)  # Eq. (16)
-        self.mass_flux = self.column_flow / (self.dx * self.width)
-        # Freeboard flow leaving cell i towards the kiln end: everything blown in at i..n-1.
-        self.freeboard_flow = np.cumsum(self.column_flow[::-1])[::-1]
+        self.set_air_flow(case.air.mass_flow)
         self.surface = bed_specific_surface(c.bed_porosity, c.particle_diameter, c.sphericity)
         self.c_rad = _radiation_conductance(case, self.n)
         self.theta = 0.5 if num.exchange == "mean" else 0.0
@@ -308,6 +352,23 @@ class _Grid:
         self.t_in = c.inlet_temperature
         self.t_air = case.air.inlet_temperature
         self.duty = c.mass_flow * float(self.props.enthalpy(self.t_in) - self.props.enthalpy(self.t_air))
+
+    def set_air_flow(self, air_flow: float) -> None:
+        """Set the total air flow (kg/s) and the column, flux and freeboard flows it implies."""
+        self.air_flow = air_flow
+        self.column_flow = _air_column_flow(self.case, self.n, air_flow)  # Eq. (16)
+        self.shares = self.column_flow / self.column_flow.sum()
+        self.mass_flux = self.column_flow / (self.dx * self.width)
+        # Freeboard flow leaving cell i towards the kiln end: everything blown in at i..n-1.
+        self.freeboard_flow = np.cumsum(self.column_flow[::-1])[::-1]
+
+    def fan_air_flow(self, ta: FloatArray) -> float:
+        """The fan's operating point at the air temperatures ``ta`` (frozen), kg/s."""
+        fan = self.case.fan
+        if fan is None:  # the case validator requires [fan] with air.supply = "fan"
+            raise ValueError("air.supply = 'fan' without a [fan] section")
+        resistance = bed_resistance(self.case, ta, self.shares, self.bed_height)
+        return operating_point(fan, resistance, self.t_air)
 
     def h(self, ts: FloatArray, ta: FloatArray) -> FloatArray:
         """Heat-transfer coefficient of every cell at the film temperature, W/(m2 K)."""
@@ -397,7 +458,7 @@ class _Grid:
         r_fb = self.column_flow * ha[-1] + flow_in * downstream + rad - self.freeboard_flow * hfb
         residual = (np.abs(r_s).sum() + np.abs(r_a).sum() + np.abs(r_fb).sum()) / self.duty
         q_clinker = self.case.clinker.mass_flow * hs_in - self.layer_flow * hs[:, -1].sum()
-        q_air = self.case.air.mass_flow * (hfb[0] - float(air_enthalpy(self.t_air)))
+        q_air = self.air_flow * (hfb[0] - float(air_enthalpy(self.t_air)))
         return float(residual), float(abs(q_clinker - q_air) / self.duty), h
 
     def air_capacity(self, ta: FloatArray) -> FloatArray:
@@ -528,30 +589,45 @@ def solve_grate(case: GrateCase) -> GrateSolution:
     ts = np.full((grid.m, grid.n), grid.t_in)
     ta = np.full((grid.m, grid.n), grid.t_air)
     tfb = np.full(grid.n, grid.t_air)
+    fan_limited = case.air.supply == "fan"
     residual, imbalance, h = grid.residuals(ts, ta, tfb)
     history: list[tuple[int, float, float]] = []
     sweeps = 0
+    flow_change = 0.0
     while True:
         grid.sweep_layers(ts, ta, tfb, h, num.under_relaxation)
         if grid.m > 1:
             grid.sweep_columns(ts, ta, tfb, h, num.under_relaxation)
         sweeps += 1
+        if fan_limited:
+            # The operating point at this sweep's air temperatures; the next sweep's fields
+            # follow it, and both converge together (no outer loop, so max_sweeps bounds all).
+            target = grid.fan_air_flow(ta)
+            flow_change = abs(target - grid.air_flow) / grid.air_flow
+            grid.set_air_flow(grid.air_flow + num.under_relaxation * (target - grid.air_flow))
         residual, imbalance, h = grid.residuals(ts, ta, tfb)
         history.append((sweeps, residual, imbalance))
-        if not (math.isfinite(residual) and math.isfinite(imbalance)):
+        if not (math.isfinite(residual) and math.isfinite(imbalance) and math.isfinite(flow_change)):
             raise GrateConvergenceError(
                 f"grate solve diverged at sweep {sweeps}; lower numerics.under_relaxation "
                 f"(now {num.under_relaxation}; allowed > 0 and <= 1)")
-        if residual < num.residual_tolerance and imbalance < num.energy_tolerance:
+        if (residual < num.residual_tolerance and imbalance < num.energy_tolerance
+                and flow_change < num.residual_tolerance):
             break
         if sweeps >= num.max_sweeps:
             raise GrateConvergenceError(
                 f"grate solve not converged after numerics.max_sweeps = {num.max_sweeps} "
                 f"sweeps: residual {residual:.3g} (tolerance {num.residual_tolerance:g}), "
-                f"energy imbalance {imbalance:.3g} (tolerance {num.energy_tolerance:g}); "
+                f"energy imbalance {imbalance:.3g} (tolerance {num.energy_tolerance:g}), "
+                f"air-flow change {flow_change:.3g} (tolerance {num.residual_tolerance:g}); "
                 "raise max_sweeps (allowed <= 100000) or loosen the tolerances")
     y = np.asarray((np.arange(grid.m) + 0.5) * grid.dy, dtype=np.float64)
     x = np.asarray((np.arange(grid.n) + 0.5) * grid.dx, dtype=np.float64)
+    if fan_limited:
+        # The solution's case carries the operating point, so every number derived from
+        # case.air.mass_flow (recovered heat, residence of the air) is the solved flow's.
+        case = case.model_copy(update={"air": case.air.model_copy(
+            update={"mass_flow": grid.air_flow})})
     return GrateSolution(
         case=case, x=x, y=y, clinker_temperature=ts, air_temperature=ta,
         freeboard_temperature=tfb, heat_transfer_coefficient=h,

@@ -194,3 +194,34 @@ def plot_sweep_outlets(sweep: Sweep, path: Path, title: str = "") -> Path:
     fig.savefig(path)
     plt.close(fig)
     return path
+
+
+def plot_sweep_recovered(sweep: Sweep, path: Path, title: str = "") -> Path:
+    """Heat recovered by the air (its largest value marked) and the air flow against the
+    varied field: with fan-limited air (``air.supply = "fan"``) the flow varies too."""
+    plt = _plt()
+    rows = sweep.rows()
+    x = [r[sweep.field] for r in rows]
+    fig, ax = plt.subplots(figsize=(6.4, 4.0), dpi=120)
+    ax.plot(x, [r["heat_recovered_MW"] for r in rows], "o-", color="tab:red", ms=3,
+            label="heat recovered by the air")
+    at, value, interior = sweep.peak("heat_recovered_MW")
+    ax.plot([at], [value], "*", color="black", ms=10,
+            label=f"largest: {value:.2f} MW at {at:g}" + ("" if interior else " (range end)"))
+    ax.set_xlabel(_label(sweep.field))
+    ax.set_ylabel("heat recovered (MW)")
+    ax.grid(alpha=0.3)
+    ax2 = ax.twinx()
+    ax2.plot(x, [r["air_flow_kg_s"] for r in rows], "s--", color="tab:blue", ms=3,
+             label="air flow")
+    ax2.set_ylabel("air flow (kg/s)", color="tab:blue")
+    lines = ax.get_legend_handles_labels()
+    lines2 = ax2.get_legend_handles_labels()
+    ax.legend(lines[0] + lines2[0], lines[1] + lines2[1], fontsize=7, loc="best")
+    supply = sweep.solutions[0].case.air.supply
+    ax.set_title(title or f"recovered heat against {_label(sweep.field)} (air: {supply})",
+                 fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)
+    return path

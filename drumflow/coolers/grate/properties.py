@@ -28,6 +28,17 @@ Convection
     Colburn factor it names is defined with Pr^(2/3), which is what is used
     here. The specific surface of the bed ("convection area factor") is the packed-bed
     value a = 6 (1 - eps) / (psi d_p) of the same section.
+
+Pressure drop
+    Not in the report (its air flow is given). For the fan-limited air
+    (:mod:`drumflow.coolers.grate.fans`) the bed's pressure gradient is Ergun's equation,
+    Bird, Stewart and Lightfoot, 2nd ed., Eq. (6.4-12), with the sphericity in the
+    diameter (psi d_p, as in the heat-transfer correlation)::
+
+        -dp/dy = 150 mu (1 - eps)^2 u / (eps^3 (psi d_p)^2) + 1.75 rho (1 - eps) u^2 / (eps^3 psi d_p)
+
+    with u = G0 / rho the superficial velocity, mu from Table A.4 and rho of the ideal gas
+    at 1 atm (the bed's few kPa change the density by a few per cent; neglected).
 """
 
 from __future__ import annotations
@@ -42,7 +53,11 @@ __all__ = [
     "AIR_T_MAX",
     "AIR_T_MIN",
     "STEFAN_BOLTZMANN",
+    "ATMOSPHERE",
+    "AIR_MOLAR_MASS",
+    "GAS_CONSTANT",
     "air_conductivity",
+    "air_density",
     "air_enthalpy",
     "air_enthalpy_scalar",
     "air_heat_capacity",
@@ -50,6 +65,7 @@ __all__ = [
     "air_temperature_from_enthalpy",
     "air_viscosity",
     "bed_specific_surface",
+    "ergun_pressure_gradient",
     "packed_bed_h",
 ]
 
@@ -57,6 +73,15 @@ FloatArray = NDArray[np.float64]
 
 STEFAN_BOLTZMANN: Final = 5.670374419e-8
 """Stefan-Boltzmann constant, W/(m2 K4) (CODATA 2018)."""
+
+GAS_CONSTANT: Final = 8.314462618
+"""Molar gas constant, J/(mol K) (CODATA 2018)."""
+
+AIR_MOLAR_MASS: Final = 0.0289644
+"""Molar mass of dry air, kg/mol (US Standard Atmosphere 1976)."""
+
+ATMOSPHERE: Final = 101325.0
+"""Pressure of the air in the bed and at the fans, Pa (the bed's few kPa are neglected)."""
 
 # Incropera 6th ed., Table A.4, air at 1 atm: T (K), c_p (kJ/(kg K)), mu * 1e7 (N s/m2),
 # k * 1e3 (W/(m K)), Pr. Rows 250-600 K are the same as drumflow.air_properties.
@@ -197,3 +222,45 @@ def packed_bed_h(mass_flux: ArrayLike, film_temperature: ArrayLike, *, diameter:
     j_h = 2.19 * safe ** (-2.0 / 3.0) + 0.78 * safe ** (-0.381)
     h = j_h * air_heat_capacity(film_temperature) * g * air_prandtl(film_temperature) ** (-2.0 / 3.0)
     return np.where(re > 0.0, h, 0.0)
+
+
+def air_density(temperature: ArrayLike, pressure: float = ATMOSPHERE) -> FloatArray:
+    """Density of air as an ideal gas, rho = p M / (R T), kg/m3, at temperature(s) in K.
+
+    Ideal gas rather than Table A.4's density column: at 1 atm and 250-2000 K the two agree
+    to the table's rounding, and the ideal gas has no interpolation error between rows.
+    """
+    return pressure * AIR_MOLAR_MASS / (GAS_CONSTANT * _clip(temperature))
+
+
+def ergun_pressure_gradient(mass_flux: ArrayLike, temperature: ArrayLike, *, diameter: float,
+                            porosity: float, sphericity: float,
+                            pressure: float = ATMOSPHERE) -> FloatArray:
+    """Pressure drop per bed height of air flowing through a packed bed (Ergun), Pa/m.
+
+    Parameters
+    ----------
+    mass_flux
+        Superficial air mass flux G0 through the bed, kg/(m2 s).
+    temperature
+        Air temperature, K (viscosity from Table A.4, density of the ideal gas).
+    diameter, porosity, sphericity
+        Particle diameter (m), bed porosity and particle sphericity psi.
+    pressure
+        Absolute pressure of the air, Pa.
+
+    Returns
+    -------
+    numpy.ndarray
+        150 mu (1 - eps)^2 u / (eps^3 (psi d)^2) + 1.75 rho (1 - eps) u^2 / (eps^3 psi d),
+        with u = G0 / rho.
+    """
+    g = np.asarray(mass_flux, dtype=np.float64)
+    rho = air_density(temperature, pressure)
+    mu = air_viscosity(temperature)
+    d_eff = sphericity * diameter
+    eps3 = porosity**3
+    u = g / rho
+    viscous = 150.0 * mu * (1.0 - porosity) ** 2 * u / (eps3 * d_eff * d_eff)
+    inertial = 1.75 * rho * (1.0 - porosity) * u * u / (eps3 * d_eff)
+    return np.asarray(viscous + inertial, dtype=np.float64)

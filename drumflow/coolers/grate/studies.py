@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, get_args
 
 import numpy as np
 
@@ -43,6 +43,8 @@ ALIASES: dict[str, str] = {
     "emissivity": "clinker.emissivity",
     "air_flow": "air.mass_flow",
     "air_inlet_temperature": "air.inlet_temperature",
+    "fan_pressure": "fan.shutoff_pressure",
+    "fan_free_delivery": "fan.free_delivery",
 }
 
 _MAX_POINTS = 200
@@ -68,8 +70,11 @@ def resolve_field(name: str) -> str:
     if len(parts) != 2 or parts[0] not in GrateCase.model_fields:
         raise CaseError([f"--vary {name!r}: unknown field; allowed: {allowed}"])
     section = GrateCase.model_fields[parts[0]].annotation
+    # An optional section (fan: Fan | None) is varied through its model.
+    section = next((t for t in get_args(section) if t is not type(None)), section)
     fields = getattr(section, "model_fields", {})
-    if parts[1] not in fields or fields[parts[1]].annotation not in (float, int):
+    numeric = (float, int, float | None)
+    if parts[1] not in fields or fields[parts[1]].annotation not in numeric:
         raise CaseError([f"--vary {name!r}: unknown or non-numeric field; allowed: {allowed}"])
     return path
 
@@ -115,9 +120,11 @@ def parse_vary(text: str) -> tuple[str, list[float]]:
 def case_with(case: GrateCase, path: str, value: float) -> GrateCase:
     """A copy of the case with one field changed, validated again (``CaseError`` names the
     field and its range when the value is outside it)."""
-    data: dict[str, Any] = case.model_dump()
+    data: dict[str, Any] = case.model_dump(exclude_none=True)
     section, name = path.split(".")
-    current = data[section][name]
+    if section not in data:
+        raise CaseError([f"--vary {path}: the case has no [{section}] section"])
+    current = data[section].get(name)
     data[section][name] = int(round(value)) if isinstance(current, int) else value
     return grate_case_from_dict(data, f"{case.name} with {path} = {value:g}")
 
@@ -131,6 +138,10 @@ def vary_cases(case: GrateCase, path: str, values: Sequence[float]) -> list[Grat
         A varied value is outside its field's range, or the study would solve more than
         :data:`MAX_STUDY_CELLS` cells.
     """
+    if path == "air.mass_flow" and case.air.supply == "fan":
+        raise CaseError([f"--vary {path}: with air.supply = 'fan' the air flow is solved "
+                         "(air.mass_flow is only its first guess); allowed: vary a fan.* "
+                         "field, or air.supply = 'fixed'"])
     cases = [case_with(case, path, v) for v in values]
     cells = sum(c.numerics.cells_length * c.numerics.cells_height for c in cases)
     if cells > MAX_STUDY_CELLS:
@@ -148,6 +159,13 @@ class Sweep:
     values: list[float]
     solutions: list[GrateSolution]
 
+    def peak(self, column: str) -> tuple[float, float, bool]:
+        """The varied value at the largest ``column`` of :meth:`rows`, that largest value, and
+        whether it is inside the range (not at either end: an interior maximum)."""
+        rows = self.rows()
+        k = int(np.argmax([r[column] for r in rows]))
+        return self.values[k], rows[k][column], 0 < k < len(rows) - 1
+
     def rows(self) -> list[dict[str, float]]:
         """One row per value: the headline numbers (the shipped study tables)."""
         out = []
@@ -159,6 +177,8 @@ class Sweep:
                 "heat_recovered_MW": sol.heat_recovered / 1e6,
                 "efficiency": sol.efficiency,
                 "radiation_MW": sol.radiation_heat / 1e6,
+                "air_flow_kg_s": sol.air_flow,
+                "bed_pressure_drop_Pa": sol.bed_pressure_drop,
                 "bed_height_m": sol.bed_height,
                 "residence_time_s": sol.case.cooler.length / sol.case.cooler.grate_speed,
                 "sweeps": float(sol.sweeps),
