@@ -53,11 +53,14 @@ def guard(console: Console | None = None) -> Iterator[None]:
         yield
     except RunStoppedError as exc:
         # Asked for (`drumflow stop`, a time limit's warning): an interruption, not an error.
-        out.print(escape(str(exc)), highlight=False)
+        out.print(escape(str(exc)), highlight=False, soft_wrap=True)
         raise typer.Exit(exit_code(exc)) from None
     except DrumflowError as exc:
         # Escaped: an error's text is plain (a list in brackets, a TOML [section]), not markup.
-        out.print(f"[bold red]error:[/] {escape(str(exc))}", highlight=False)
+        # soft_wrap: no line breaks of rich's own inside the message (at COLUMNS=80 it broke
+        # "another scene" across two lines, depending on the length of the path before it), so
+        # a message can be searched, and a terminal still wraps it for the eye.
+        out.print(f"[bold red]error:[/] {escape(str(exc))}", highlight=False, soft_wrap=True)
         raise typer.Exit(exit_code(exc)) from None
     except KeyboardInterrupt as exc:
         out.print("interrupted")

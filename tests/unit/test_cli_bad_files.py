@@ -285,16 +285,19 @@ def test_plant_reads_the_gzipped_crossing_table(tmp_path: Path) -> None:
     assert result["slice"]["airborne_fraction"] > 0
 
 
-def test_plant_on_the_shipped_results_names_what_they_lack(tmp_path: Path) -> None:
-    """The shipped results keep the crossing table (gzipped) but no snapshot: the closures'
-    airborne share, speeds and bed surface cannot be measured from them, and the refusal says
-    so instead of asking for post/crossings.csv."""
-    out = _drumflow("plant", str(SHIPPED), "--json", "--out", str(tmp_path / "plant"))
+def test_plant_on_results_without_snapshots_or_closures_names_what_they_lack(tmp_path: Path) -> None:
+    """Shipped results keep the crossing table (gzipped) and the closures `drumflow post`
+    measured (post/closures.json), but no snapshot: without that file the closures' airborne
+    share, speeds and bed surface cannot be measured, and the refusal says so instead of asking
+    for post/crossings.csv. (With it the plant runs: test_plant_from_shipped_results.py.)"""
+    results = _shipped_copy(tmp_path)
+    (results / "post" / "closures.json").unlink()
+    out = _drumflow("plant", str(results), "--json", "--out", str(tmp_path / "plant"))
     text = _flat(out.stdout + out.stderr)
     assert out.returncode == 2, text
     assert "Traceback" not in text
     assert "crossings.csv: missing" not in text
-    assert "dem/dumps: no particle snapshot" in text
+    assert "dem/dumps: no particle snapshot" in text and "no closures.json" in text
     assert "--save-closures" in text
 
 
