@@ -9,8 +9,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from test_drum_model import CLOSURES
 
-from drumflow.analysis.closures import SliceClosures
 from drumflow.analysis.predict import PAPER_PLANT
 from drumflow.coolers._curtain_pass import curtain_pass
 from drumflow.coolers._propagator import exposure_matrix
@@ -24,16 +24,7 @@ from drumflow.coolers.drum import DrumModelError, DrumOptions, solve_drum
 from drumflow.coolers.particle_interior import Sphere, SphereConduction
 from drumflow.coolers.plant_balance import measured_balance, shell_loss_coefficient
 
-# The hand-written closures of test_drum_model (a 0.4 m slice) and its short, small plant.
-CLOSURES = SliceClosures(
-    source="hand-written", case_name="hand", drum_diameter_m=0.4, section_length_m=0.08,
-    rpm=15.0, tilt_deg=1.5, lifter_count=8, particle_diameter_m=8e-3,
-    particle_density_kg_m3=1050.0, holdup_kg_per_m=10.56, solids_volume_fraction=0.08,
-    air_axial_velocity_m_s=3.0, falling_mass_flow_kg_s_m=3.4, airborne_fraction=0.04,
-    fall_time_s=0.13, fall_height_m=0.16, airborne_speed_m_s=1.3,
-    airborne_downward_speed_m_s=1.25, slip_velocity_m_s=3.3, bed_slip_velocity_m_s=3.1,
-    bed_surface_m2_per_m=0.25, snapshots=9, window_s=(1.0, 3.0),
-)
+# The hand-written closures of test_drum_model (a 0.4 m slice), shared with it.
 SMALL = PAPER_PLANT.changed(length_m=6.0, feed_rate_kg_s=4.0, air_mass_flow_kg_s=8.0)
 SMALL_LAW = calibrate(SMALL, 600.0)
 SPHERE = Sphere(2.7e-3, 0.18596, 1050.0, 1465.38)
