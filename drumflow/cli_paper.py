@@ -4,7 +4,7 @@ Without ``--from`` it runs (or resumes) each model's shipped case, ``cases/paper
 and ``cases/paper_model_two.toml``, into ``OUT/model_one`` and ``OUT/model_two`` through the same
 pipeline as ``drumflow run`` (a finished run is reused), then compares every model directory
 that exists. With ``--from DIR`` it only reads: ``DIR/model_one`` and ``DIR/model_two`` may be
-run directories or the small results ``scripts/ship_paper_run.py`` ships, and the page is
+run directories or the small results ``studies/ship_paper_run.py`` ships, and the page is
 redrawn without any solver. Either way it writes ``OUT/paper.json``, ``OUT/comparison.csv`` and
 the HTML page (``--html``, default ``OUT/paper.html``).
 

@@ -3,7 +3,7 @@
 Every shortcut drumflow takes (or the case asks for) is recorded in the run's manifest under
 ``skips``: what is skipped, the speed-up and the errors against the finest setting as
 measured on the reference scene (``drumflow/data/measured_smoke.json``, package data written
-by ``scripts/ship_bench.py`` from ``drumflow bench cases/smoke.toml`` on the machine named in
+by ``studies/ship_bench.py`` from ``drumflow bench cases/smoke.toml`` on the machine named in
 it). The pipeline records them; this module sits low (it imports no stage) so that any stage or
 the bench can use it. The numbers are the smoke scene's; on another
 scene they are a guide, and ``drumflow bench`` on that scene measures its own.

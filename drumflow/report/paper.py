@@ -1,7 +1,7 @@
 """The paper page: drumflow's runs of the paper's two cases beside Burgos-Florez et al. (2019).
 
 For each model directory (a ``drumflow run`` directory, or the small results shipped from one by
-``scripts/ship_paper_run.py``, which keeps the same layout without the dumps) this module
+``studies/ship_paper_run.py``, which keeps the same layout without the dumps) this module
 gathers what the paper reports and drumflow measured:
 
 * the run's record: simulated time reached against the case's, wall time, machine;

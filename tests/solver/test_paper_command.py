@@ -3,7 +3,7 @@
 One module-scoped run of the tiny drum (0.2 m, 500 particles of 8 mm) in the CFD air field of a
 coarse mesh, 0.6 s, run through ``drumflow paper --model two --case tiny.toml`` (the command's
 run path: the same pipeline as ``drumflow run``). Its results are shipped with
-``scripts/ship_paper_run.py`` and redrawn with ``drumflow paper --from`` and ``drumflow report``,
+``studies/ship_paper_run.py`` and redrawn with ``drumflow paper --from`` and ``drumflow report``,
 with no solver. The tiny drum is not the paper's model two: the comparison's numbers are
 meaningless here; what is tested is that every number reaches the page unchanged, and the
 finding of issue 10 (a) on a real run: Eq. 39's h is the h the coupling applied over every
@@ -63,9 +63,9 @@ def paper_run(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
     again = _run("-m", "drumflow.cli", "paper", "--model", "two", "--case", str(case_file),
                  "--out", str(out), "--json")
     shipped = root / "shipped"
-    ship = _run("scripts/ship_paper_run.py", str(out / "model_two"), str(shipped / "model_two"))
+    ship = _run("studies/ship_paper_run.py", str(out / "model_two"), str(shipped / "model_two"))
     # The same run shipped as if its crossings were too large to keep: a summary instead.
-    _run("scripts/ship_paper_run.py", str(out / "model_two"), str(root / "summarised" / "model_two"),
+    _run("studies/ship_paper_run.py", str(out / "model_two"), str(root / "summarised" / "model_two"),
          "--crossings-limit-mb", "0", "--no-3d")
     redrawn = _run("-m", "drumflow.cli", "paper", "--from", str(shipped), "--out", str(root / "out2"),
                    "--json")

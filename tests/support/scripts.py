@@ -1,4 +1,4 @@
-"""The repository's ``scripts/`` are programs, not a package: tests load one by its path."""
+"""The repository's ``studies/`` are programs, not a package: tests load one by its path."""
 
 from __future__ import annotations
 
@@ -6,11 +6,11 @@ import importlib.util
 from pathlib import Path
 from types import ModuleType
 
-SCRIPTS = Path(__file__).resolve().parents[2] / "scripts"
+SCRIPTS = Path(__file__).resolve().parents[2] / "studies"
 
 
 def load_script(name: str) -> ModuleType:
-    """``scripts/<name>.py`` as a module (its ``main`` is not run)."""
+    """``studies/<name>.py`` as a module (its ``main`` is not run)."""
     spec = importlib.util.spec_from_file_location(name, SCRIPTS / f"{name}.py")
     assert spec is not None and spec.loader is not None
     module = importlib.util.module_from_spec(spec)

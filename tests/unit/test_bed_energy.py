@@ -1,4 +1,4 @@
-"""scripts/bed_energy.py: a row spacing that is not positive is refused by name before any
+"""studies/bed_energy.py: a row spacing that is not positive is refused by name before any
 file is read (the script reads a run's whole thermo log, minutes on a long run)."""
 
 from __future__ import annotations

@@ -197,7 +197,7 @@ def test_bad_gap_is_refused() -> None:
 
 
 def test_a_snapshots_columns_give_the_same_pairs_as_the_arrays() -> None:
-    """The snapshot reader's columns (as `drumflow bench --from` and scripts/impact_speeds.py
+    """The snapshot reader's columns (as `drumflow bench --from` and studies/impact_speeds.py
     pass them) stack into the centres, velocities and radii the measurement takes."""
     x, v, r = _pair(0.5 * GAP, np.array([0.3, 0.0, 0.0]), np.array([-0.2, 0.0, 0.0]),
                     np.array([1.0, 0.0, 0.0]))

@@ -1,4 +1,4 @@
-"""scripts/replicate_error.py on model one's first full-particle run (to 3.515 s, shipped in
+"""studies/replicate_error.py on model one's first full-particle run (to 3.515 s, shipped in
 results/paper/model_one_replicate/first_run): a copy of it is its own replicate (every
 difference 0), a copy with its temperatures shifted shows the shift, and a run of another case
 is refused."""

@@ -1,4 +1,4 @@
-"""scripts/variant_flow.py on a hand-built settings study: known crossing times give known
+"""studies/variant_flow.py on a hand-built settings study: known crossing times give known
 flows per window and in all, the run itself is cut to the study's interval, and a run that
 stopped before the interval's end is refused."""
 

@@ -89,7 +89,7 @@ Fan-limited air
     holds the operating point as ``air.mass_flow``.
 
 Runtime
-    Measured in ``docs/grate/runtime.csv`` (written by ``scripts/grate_studies.py``).
+    Measured in ``docs/grate/runtime.csv`` (written by ``studies/grate_studies.py``).
 """
 
 from __future__ import annotations

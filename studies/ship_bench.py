@@ -1,6 +1,6 @@
 """Copy a smoke-scene bench's measured numbers into the package (drumflow/data/measured_smoke.json).
 
-Usage: python scripts/ship_bench.py [runs/bench/smoke/results.json]
+Usage: python studies/ship_bench.py [runs/bench/smoke/results.json]
 
 Runs record their shortcuts with these numbers in the manifest (drumflow.skips).
 """

@@ -2,7 +2,7 @@
 
 How to use::
 
-    .venv/bin/python scripts/bed_energy.py RUN_DIR OUT_DIR [--every 0.05]
+    .venv/bin/python studies/bed_energy.py RUN_DIR OUT_DIR [--every 0.05]
 
 Reads the LIGGGHTS logs of RUN_DIR's DEM stage (every attempt, a resumed one superseding what
 earlier attempts wrote after its restart: ``drumflow.dem.thermo.read_thermo``) and writes, one

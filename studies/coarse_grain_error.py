@@ -3,7 +3,7 @@ lever 7).
 
 How to use::
 
-    .venv/bin/python scripts/coarse_grain_error.py FULL PARCELS OUT_DIR [--at 3.5] [--until 3.5219]
+    .venv/bin/python studies/coarse_grain_error.py FULL PARCELS OUT_DIR [--at 3.5] [--until 3.5219]
 
 FULL and PARCELS are run directories (or shipped results folders) of the same case, PARCELS
 with ``particles.coarse_grain > 1``. Compared, with the choices fixed before looking: the mean

@@ -2,11 +2,11 @@
 
 How to use::
 
-    .venv/bin/python scripts/replicate_error.py FIRST SECOND OUT_DIR [--until T] [--window 0.5]
+    .venv/bin/python studies/replicate_error.py FIRST SECOND OUT_DIR [--until T] [--window 0.5]
                                                 [--progress]
 
 FIRST and SECOND are run directories (or shipped results folders, see
-``scripts/ship_paper_run.py``) of the same case (same physics; the launch, the processor grid
+``studies/ship_paper_run.py``) of the same case (same physics; the launch, the processor grid
 and the attempt history may differ, so their round-off does and the trajectories part
 chaotically), or of two cases that differ only in the fields named by ``--differ FIELD``
 (``--differ name --differ run.time_step``: one setting against another). Compared over the

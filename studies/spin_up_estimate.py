@@ -2,7 +2,7 @@
 
 How to use::
 
-    .venv/bin/python scripts/spin_up_estimate.py RUN OUT_DIR [--starts 3,5] [--reference-wall S]
+    .venv/bin/python studies/spin_up_estimate.py RUN OUT_DIR [--starts 3,5] [--reference-wall S]
 
 RUN is a finished, post-processed run of a paper case (or its shipped folder,
 ``results/paper/model_two``). Lever 2 would cache the settled, cascading bed once and start

@@ -6,7 +6,7 @@ every particle, with the particles' own velocities. For each field and snapshot 
 surface-mean Ranz-Marshall h over all, bed and airborne particles, and the mean temperature at
 3.5 s that a lumped particle would reach at that h (drumflow.analysis.air_side). No solver.
 
-    python scripts/air_side_study.py RUN_DIR --field coarse=PATH.npz --field fine=PATH.npz \
+    python studies/air_side_study.py RUN_DIR --field coarse=PATH.npz --field fine=PATH.npz \
         --out results/paper/model_two/air_side.csv [--paper-h 38.93]
 
 The run's case gives the drum speed, the air temperature and the particle properties.

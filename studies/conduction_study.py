@@ -2,7 +2,7 @@
 
 How to use::
 
-    .venv/bin/python scripts/conduction_study.py OUT_DIR ON_RUN OFF_RUN
+    .venv/bin/python studies/conduction_study.py OUT_DIR ON_RUN OFF_RUN
 
 ON_RUN and OFF_RUN are run directories of one scene to the same time, the first with
 ``run.conduction = true`` (the paper's Eq. 24), the second with ``false`` (no heat fix in

@@ -1,12 +1,12 @@
 """Mutation testing of the reduced-order cooler models, the coupling laws and the air tables
-(issue 36), with mutmut 3. Driven by ``scripts/mutation.sh``; see README "Mutation testing".
+(issue 36), with mutmut 3. Driven by ``studies/mutation.sh``; see README "Mutation testing".
 
 The work tree is never touched: the tracked files are copied to a scratch directory
 (default ``/tmp/drumflow-mutation``), mutmut's configuration is appended to the copy's
 ``pyproject.toml``, and mutmut makes its ``mutants/`` there. The venv's editable install of
 drumflow is shadowed because mutmut puts ``mutants/`` first on ``sys.path``.
 
-    python scripts/mutation.py [--modules curtain physics ...] [--max-children 1]
+    python studies/mutation.py [--modules curtain physics ...] [--max-children 1]
 
 writes ``results/mutation/summary.json`` (killed / total per module, wall time; runs of
 other modules are kept) and ``results/mutation/survivors_raw/<module>.md`` (every surviving

@@ -2,7 +2,7 @@
 as CSV, the grid-convergence table, the trend table beside the report's statements, and the
 runtime of one solve.
 
-Usage: ``.venv/bin/python scripts/grate_studies.py [--case cases/grate_cooler_report.toml]
+Usage: ``.venv/bin/python studies/grate_studies.py [--case cases/grate_cooler_report.toml]
 [--out docs/grate]`` (about a minute on a laptop).
 """
 

@@ -2,7 +2,7 @@
 
 Writes runs/bench/air_sampling.json: samples per second of drumflow.air.field.AirField.sample
 and of scipy's RegularGridInterpolator on the same grid and points, measured side by side in
-one run, and their ratio. Usage: .venv/bin/python scripts/bench_air_sampling.py [OUT.json]
+one run, and their ratio. Usage: .venv/bin/python studies/bench_air_sampling.py [OUT.json]
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """Impact speeds at paper scale from a run's snapshots, and the DEM step they allow (issue 11).
 
-Usage: python scripts/impact_speeds.py RUN_DIR OUT_DIR [--from-time 2.5] [--gap 0.1]
+Usage: python studies/impact_speeds.py RUN_DIR OUT_DIR [--from-time 2.5] [--gap 0.1]
                                        [--check-gap 0.05]
 
 Reads RUN_DIR/case.toml, RUN_DIR/manifest.json (the time step, to date the snapshots) and

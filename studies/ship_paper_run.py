@@ -1,6 +1,6 @@
 """Ship the small results of a paper run: what must last, never the dumps.
 
-    python scripts/ship_paper_run.py RUN_DIR results/paper/model_two [--no-3d]
+    python studies/ship_paper_run.py RUN_DIR results/paper/model_two [--no-3d]
         [--crossings-limit-mb 5] [--force]
 
 Copies from a ``drumflow run`` directory (finished, or interrupted and post-processed with

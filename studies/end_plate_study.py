@@ -2,7 +2,7 @@
 
 How to use::
 
-    .venv/bin/python scripts/end_plate_study.py OUT_DIR RUN [RUN ...]
+    .venv/bin/python studies/end_plate_study.py OUT_DIR RUN [RUN ...]
 
 Each RUN is a run directory (or shipped results folder) of the same scene in sections of
 different lengths, the particle count in proportion (the same fill). Model one's section is

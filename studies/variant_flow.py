@@ -2,7 +2,7 @@
 
 How to use::
 
-    .venv/bin/python scripts/variant_flow.py STUDY_DIR OUT_DIR [--run RUN_DIR] [--window 0.05]
+    .venv/bin/python studies/variant_flow.py STUDY_DIR OUT_DIR [--run RUN_DIR] [--window 0.05]
 
 STUDY_DIR is what ``drumflow bench CASE --from RUN_DIR --out STUDY_DIR`` wrote: every variant
 ran the same simulated time from one restart, with the crossings counted in the coupling loop

@@ -5,7 +5,7 @@ scratch folder, reads it as text, packs it, reads the packed file, side by side 
 (best of three reads each), and writes OUT.json: sizes, read times, their ratios and the
 largest difference per column. The run's own files are not touched.
 
-Usage: .venv/bin/python scripts/bench_snapshot_packing.py RUN_DIR OUT.json
+Usage: .venv/bin/python studies/bench_snapshot_packing.py RUN_DIR OUT.json
 """
 
 from __future__ import annotations
