@@ -9,7 +9,7 @@ Every external program is started through :mod:`drumflow.runner`; every run writ
 :mod:`drumflow.rundir`.
 
 Importing this package is light: the names below are loaded on first use (module
-``__getattr__``), so importing a small module such as :mod:`drumflow.coolers.particle_interior`
+``__getattr__``), so importing a small module such as :mod:`drumflow.physics.particle_interior`
 does not load pandas or the pipeline.
 """
 

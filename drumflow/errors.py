@@ -10,10 +10,6 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING
-
-if TYPE_CHECKING:
-    from drumflow.air.foam_results import AirSolution
 
 
 class DrumflowError(Exception):
@@ -198,7 +194,9 @@ class AirNotConvergedError(SolverError):
         final_residuals: dict[str, float],
         target: float,
         log: Path | None,
-        solution: AirSolution | None = None,
+        # Typed loosely on purpose: the errors are the floor under every stage and import none
+        # of them (an AirSolution type here made errors <-> air.foam_results a circle).
+        solution: object | None = None,
     ) -> None:
         self.iterations = iterations
         self.final_residuals = dict(final_residuals)

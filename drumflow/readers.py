@@ -37,6 +37,7 @@ __all__ = [
     "read_csv",
     "read_json",
     "read_json_object",
+    "read_json_object_if_present",
     "read_npz",
     "read_text",
     "reaches_time",
@@ -112,6 +113,18 @@ def read_json_object(path: Path | str, what: str = "") -> dict[str, Any]:
         raise BadFileError(path, f"holds a JSON {type(data).__name__}, expected an object "
                            "({...})", what)
     return data
+
+
+def read_json_object_if_present(path: Path | str, what: str = "") -> dict[str, Any] | None:
+    """:func:`read_json_object`, or None when the file does not exist.
+
+    For the files a run writes late or not at all (``summary.json``, cached results): a missing
+    one is a fact to report, but a damaged one (cut short, not UTF-8, not an object) is still
+    refused by name, since dropping it would show the run without it, and without a word.
+    """
+    if not Path(path).exists():
+        return None
+    return read_json_object(path, what)
 
 
 def read_csv(

@@ -293,6 +293,13 @@ class RunDir:
         """The methodology's per-step table."""
         return self.post / "steps.csv"
 
+    # -- what the manifest records ---------------------------------------------------
+    @property
+    def recorded_time_step(self) -> float | None:
+        """The DEM time step the run recorded (s), or None before the DEM stage chose one."""
+        value = (self.manifest.get("time_step") or {}).get("time_step")
+        return float(value) if value else None
+
     # -- case binding ------------------------------------------------------------------
     def bind_case(self, case_json: str, case_hash: str, case_toml: str, force: bool = False,
                   versions: dict[str, Any] | None = None) -> None:

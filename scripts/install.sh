@@ -29,9 +29,11 @@ if [ ! -x .venv/bin/python ]; then
 fi
 # Reinstall only when pyproject.toml changed since the last install.
 stamp=".venv/.drumflow-installed"
-if [ ! -f "$stamp" ] || [ pyproject.toml -nt "$stamp" ] || ! .venv/bin/python -c "import drumflow" 2>/dev/null; then
+if [ ! -f "$stamp" ] || [ pyproject.toml -nt "$stamp" ] || ! .venv/bin/python -c "import drumflow" 2>/dev/null \
+   || [ ! -x .venv/bin/mkdocs ]; then
   .venv/bin/python -m pip install -q --upgrade pip >/dev/null
-  .venv/bin/python -m pip install -q -e ".[test]"
+  # test: the test suite's tools; docs: the documentation site that scripts/test.sh builds.
+  .venv/bin/python -m pip install -q -e ".[test,docs]"
   touch "$stamp"
 fi
 # `liggghts -h` exits non-zero; only its version line matters here.

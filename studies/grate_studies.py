@@ -18,7 +18,8 @@ import numpy as np
 
 from drumflow.coolers.grate import plots
 from drumflow.coolers.grate.case import GrateCase, load_grate_case
-from drumflow.coolers.grate.model import GrateSolution, solve_grate
+from drumflow.coolers.grate.model import solve_grate
+from drumflow.coolers.grate.solution import GrateSolution
 from drumflow.coolers.grate.studies import Sweep, case_with, grid_study, run_sweep
 
 ROOT = Path(__file__).resolve().parents[1]

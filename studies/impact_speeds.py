@@ -26,14 +26,10 @@ import numpy as np
 
 from drumflow.case import Case, load_case
 from drumflow.dem import impacts
+from drumflow.dem.collision_speed import G, impact_velocity
 from drumflow.dem.dumps import dump_files, read_dump
 from drumflow.dem.impacts import WALL_EQUIVALENT_SPEED_FACTOR, ImpactSample
-from drumflow.dem.timestep import (
-    MIN_STEPS_PER_CONTACT,
-    G,
-    choose_time_step,
-    impact_velocity,
-)
+from drumflow.dem.timestep import MIN_STEPS_PER_CONTACT, choose_time_step
 from drumflow.errors import DrumflowError
 
 QUANTILES = (0.5, 0.9, 0.99, 0.999, 1.0)

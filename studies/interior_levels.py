@@ -12,7 +12,7 @@ their wall times are measured on the same machine in one sitting; a finished run
 Measured per run, with the choices fixed before any run (``results/paper/levels/prediction.json``
 holds the prediction written first): the mean temperature at 3.5 s; h by the paper's Eq. 39
 (:func:`drumflow.analysis.methodology.analyse_run`) and from the coupling log
-(:func:`drumflow.analysis.paper.coupling_h`); the granules' centre-minus-surface difference at
+(:func:`drumflow.analysis.published.coupling_h`); the granules' centre-minus-surface difference at
 3.5 s (the interior log; 0 for lumped particles); the air's outlet temperature if it took the
 heat of the slice (one-way air does not warm: this is what it would reach), and the volumetric
 coefficient Q / (V (T_particles - T_air)) of the slice over 1 s to the end, beside the plant's
@@ -93,7 +93,7 @@ def measure(out: Path, at_s: float, until_s: float) -> dict[str, Any]:
     """The level table's numbers for one run directory (or shipped results folder), over its
     first ``until_s`` seconds (runs of different lengths compare over the same window)."""
     from drumflow.analysis.methodology import analyse_run
-    from drumflow.analysis.paper import coupling_h
+    from drumflow.analysis.published import coupling_h
     from drumflow.case import load_case
 
     case = load_case(out / "case.toml")

@@ -47,17 +47,16 @@ from drumflow.analysis.methodology import analyse_run, write_methodology
 from drumflow.case import load_case
 from drumflow.errors import DrumflowError, RunDirectoryError, exit_code
 from drumflow.report.animation import ANIMATION, render_animation
-from drumflow.report.paper import (
+from drumflow.report.paper_results import (
     AIR_SIDE,
     CROSSINGS_SUMMARY,
     PARTICLES_3D,
     PARTICLES_TIMES,
     RUN_RECORD,
     air_side_of_run,
-    render_last_snapshot,
-    render_snapshot_panels,
     run_record,
 )
+from drumflow.report.snapshots import render_last_snapshot, render_snapshot_panels
 from drumflow.rundir import RunDir
 
 #: Files copied as they are when present (relative to the run directory).

@@ -40,7 +40,8 @@ from typing import Any
 import pandas as pd
 
 from drumflow._json import json_safe
-from drumflow.bench.answer import AnswerReplay, replay_answer
+from drumflow.bench.answer import replay_answer
+from drumflow.bench.answer_result import AnswerReplay
 from drumflow.case import load_case
 from drumflow.errors import DrumflowError, exit_code
 

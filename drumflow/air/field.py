@@ -9,23 +9,23 @@ Frames and velocities: the grid holds the **absolute** (laboratory-frame) air ve
 its components along the drum-frame axes. A particle at lab position ``x`` at time ``t`` sits
 at drum-frame position ``R(-omega t) x`` (the drum turns counter-clockwise about +z, as the
 LIGGGHTS shell does); the sampled velocity turns back to lab components by ``R(+omega t)``.
-:func:`rotate_to_drum_frame`, :func:`rotate_to_lab_frame` and :meth:`AirField.sample_lab` do
-this. The air flows towards -z (it enters at z = l).
+:func:`~drumflow.physics.drum_frame.rotate_to_drum_frame`,
+:func:`~drumflow.physics.drum_frame.rotate_to_lab_frame` and :meth:`AirField.sample_lab` do this.
+The air flows towards -z (it enters at z = l).
 
 Grid nodes that are not in the fluid (inside a lifter plate or outside the shell) take the
 value of the nearest fluid cell (:class:`scipy.spatial.cKDTree`), so trilinear interpolation
 next to a wall never blends in zeros or garbage, and a particle touching a wall sees the air
 just beside it. Fluid nodes get a weighted linear least-squares fit to their nearest cell
-centres and inlet/outlet face centres (:func:`local_linear_fit`: exact for linear fields,
-clipped to the neighbours' range so it never overshoots near walls). The walls' own no-slip
-values are not used, see :meth:`AirField.from_solution`.
+centres and inlet/outlet face centres (:func:`~drumflow.air.field_grid.local_linear_fit`:
+exact for linear fields, clipped to the neighbours' range so it never overshoots near walls).
+The walls' own no-slip values are not used, see :meth:`AirField.from_solution`.
 """
 
 from __future__ import annotations
 
 import hashlib
 import json
-import math
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -33,6 +33,9 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
+
+from drumflow.air.field_grid import fluid_mask_xy, grid_axes, grid_spacing, local_linear_fit
+from drumflow.physics.drum_frame import drum_angle, rotate_to_drum_frame, rotate_to_lab_frame
 
 if TYPE_CHECKING:
     from drumflow.air.foam import AirSolution
@@ -42,40 +45,9 @@ if TYPE_CHECKING:
 #: algorithm never reuses an old cached field.
 FIELD_FORMAT_VERSION = 1
 
-#: Largest number of grid nodes :func:`grid_spacing` allows (about 0.5 GB of float64 vectors).
-MAX_GRID_NODES = 20_000_000
 
 
 # -- frames ----------------------------------------------------------------------------
-
-
-def _rotate(vectors: NDArray[np.float64], angle: float) -> NDArray[np.float64]:
-    v = np.asarray(vectors, dtype=float)
-    c, s = math.cos(angle), math.sin(angle)
-    out = np.empty(v.shape, dtype=float)
-    out[..., 0] = c * v[..., 0] - s * v[..., 1]
-    out[..., 1] = s * v[..., 0] + c * v[..., 1]
-    out[..., 2] = v[..., 2]
-    return out
-
-
-def rotate_to_drum_frame(points: NDArray[np.float64], angle: float) -> NDArray[np.float64]:
-    """Lab-frame points or vectors (..., 3) in drum-frame coordinates.
-
-    Parameters
-    ----------
-    points
-        Lab-frame positions (or vectors), shape (..., 3).
-    angle
-        The drum's rotation angle since the field's reference instant, ``omega * t``, rad.
-        The drum turns counter-clockwise about +z, so this rotates by ``-angle``.
-    """
-    return _rotate(points, -angle)
-
-
-def rotate_to_lab_frame(vectors: NDArray[np.float64], angle: float) -> NDArray[np.float64]:
-    """Drum-frame vectors or points (..., 3) in lab-frame components (rotation by ``+angle``)."""
-    return _rotate(vectors, angle)
 
 
 # -- cache key -------------------------------------------------------------------------
@@ -112,120 +84,6 @@ def air_cache_key(case: Case) -> str:
     }
     return hashlib.sha256(json.dumps(key, sort_keys=True).encode()).hexdigest()
 
-
-# -- the grid --------------------------------------------------------------------------
-
-
-def grid_spacing(case: Case) -> float:
-    """Default grid spacing, m: a quarter of the bulk CFD cell (half the near-wall cell), at
-    most D/80.
-
-    Finer than the CFD cells it samples, so trilinear interpolation adds little to the CFD's
-    own error (on the smoke drum, halving the spacing from 0.01 m to 0.005 m cut the median
-    difference from the cell values within 5 mm of a wall from 0.31 to 0.18 m/s; away from the
-    walls it is below 0.01 m/s); grown if the grid would pass :data:`MAX_GRID_NODES`.
-    """
-    from drumflow.geometry.fluid import fluid_mesh_size
-
-    D, L = case.drum.diameter, case.drum.length
-    h = min(0.25 * fluid_mesh_size(case), D / 80.0)
-    nodes = (D / h + 1) ** 2 * (L / h + 1)
-    if nodes > MAX_GRID_NODES:
-        h *= (nodes / MAX_GRID_NODES) ** (1.0 / 3.0)
-    return h
-
-
-def _grid_axes(case: Case, spacing: float) -> tuple[list[NDArray[np.float64]], NDArray, NDArray]:
-    R, L = case.drum.radius, case.drum.length
-    lo = np.array([-R, -R, 0.0])
-    hi = np.array([R, R, L])
-    n = np.maximum(2, np.ceil((hi - lo) / spacing - 1e-9).astype(int) + 1)
-    axes = [np.linspace(lo[i], hi[i], n[i]) for i in range(3)]
-    return axes, lo, (hi - lo) / (n - 1)
-
-
-def fluid_mask_xy(case: Case, x: NDArray[np.float64], y: NDArray[np.float64]) -> NDArray[np.bool_]:
-    """True where cross-section points (x, y) are air: inside the shell and outside the lifters."""
-    from drumflow.geometry.lifters import distance_to_lifters
-
-    pts = np.column_stack([np.ravel(x), np.ravel(y)])
-    inside = np.hypot(pts[:, 0], pts[:, 1]) < case.drum.radius
-    if case.lifters.count > 0:
-        inside &= distance_to_lifters(pts, case.drum.radius, case.lifters) > 0.0
-    return inside.reshape(np.shape(x))
-
-
-def local_linear_fit(
-    support: NDArray[np.float64],
-    values: NDArray[np.float64],
-    query: NDArray[np.float64],
-    k: int = 12,
-    tree: Any = None,
-    chunk: int = 65_536,
-) -> NDArray[np.float64]:
-    """Values at ``query`` points from a weighted linear fit to the ``k`` nearest support points.
-
-    At each query point q, ``a + B (x - q)`` is fitted by least squares to the k nearest
-    support values with weights 1 / (d / d_k + 0.001)^2 (d_k: the k-th distance), and ``a`` is
-    the answer: exact for fields linear in x, y, z, second-order accurate for smooth ones.
-    The result is clipped to the neighbours' range, so near walls, where the fit
-    extrapolates from one side, it never overshoots. A tiny ridge term on the gradient keeps
-    degenerate (coplanar) neighbourhoods solvable.
-
-    Parameters
-    ----------
-    support
-        (n, 3) points carrying data (cell centres, boundary face centres).
-    values
-        (n, c) data at them.
-    query
-        (m, 3) points to evaluate at.
-    k
-        Neighbours per fit (at least 4 are needed for a 3D linear fit).
-    tree
-        A :class:`scipy.spatial.cKDTree` of ``support``, if one is at hand.
-    chunk
-        Query points per vectorised batch (bounds the memory to ~ chunk * k * 100 bytes).
-
-    Notes
-    -----
-    Chosen over Delaunay interpolation of the cell centres (bounded and exact, but Qhull's
-    triangulation and point location took 60 s for 320k grid nodes in the 3 m drum's
-    170k cells, and 180 s for 2.4M) and over pyvista's probe (133k points/s): this takes a
-    few seconds per million nodes.
-    """
-    from scipy.spatial import cKDTree
-
-    support = np.asarray(support, dtype=float)
-    values = np.asarray(values, dtype=float)
-    query = np.asarray(query, dtype=float)
-    if values.ndim == 1:
-        values = values[:, None]
-    out = np.empty((len(query), values.shape[1]))
-    if len(query) == 0:
-        return out
-    k = min(k, len(support))
-    tree = cKDTree(support) if tree is None else tree
-    eye = np.eye(3)
-    for s in range(0, len(query), chunk):
-        q = query[s : s + chunk]
-        d, idx = tree.query(q, k=k)
-        if k == 1:
-            out[s : s + chunk] = values[idx]
-            continue
-        scale = d[:, -1:] + 1e-300
-        D = (support[idx] - q[:, None, :]) / scale[:, :, None]
-        w = 1.0 / (d / scale + 1e-3) ** 2
-        A = np.concatenate([np.ones(D.shape[:2] + (1,)), D], axis=2)
-        Aw = A * w[:, :, None]
-        N = np.einsum("mki,mkj->mij", Aw, A)
-        N[:, 1:, 1:] += 1e-9 * w.sum(axis=1)[:, None, None] * eye
-        V = values[idx]
-        coef = np.linalg.solve(N, np.einsum("mki,mkc->mic", Aw, V))
-        est = coef[:, 0, :]
-        np.clip(est, V.min(axis=1), V.max(axis=1), out=est)
-        out[s : s + chunk] = est
-    return out
 
 
 @dataclass
@@ -365,7 +223,7 @@ class AirField:
 
     def sample_lab(self, points: NDArray[np.float64], time_s: float) -> NDArray[np.float64]:
         """Air velocity in lab components at (n, 3) lab-frame points at time ``time_s``."""
-        angle = self.omega * time_s
+        angle = drum_angle(self.omega, time_s)
         return rotate_to_lab_frame(self.sample(rotate_to_drum_frame(points, angle)), angle)
 
     def mean_axial_velocity(self) -> float:
@@ -413,7 +271,7 @@ class AirField:
         n = len(centres)
         p_cells = np.zeros(n) if pressure is None else np.asarray(pressure, dtype=float)
         h = grid_spacing(case) if spacing is None else float(spacing)
-        axes, lo, step = _grid_axes(case, h)
+        axes, lo, step = grid_axes(case, h)
         X, Y = np.meshgrid(axes[0], axes[1], indexing="ij")
         mask2d = fluid_mask_xy(case, X, Y)
         nx, ny, nz = len(axes[0]), len(axes[1]), len(axes[2])
@@ -500,7 +358,7 @@ class AirField:
         rho = air_density(case)
         u = case.air.mass_flow / (rho * area)
         h = grid_spacing(case) if spacing is None else float(spacing)
-        axes, lo, step = _grid_axes(case, h)
+        axes, lo, step = grid_axes(case, h)
         X, Y = np.meshgrid(axes[0], axes[1], indexing="ij")
         nx, ny, nz = len(axes[0]), len(axes[1]), len(axes[2])
         fluid = np.broadcast_to(fluid_mask_xy(case, X, Y)[:, :, None], (nx, ny, nz)).copy()
@@ -578,73 +436,3 @@ class AirField:
             omega=float(z["omega"]),
             meta=meta,
         )
-
-
-def plot_air_cross_section(
-    air: AirField, case: Case, path: Path, z: float | None = None, resolution: int = 240
-) -> None:
-    """PNG of the air speed in a drum cross-section (default: mid length, z = l/2).
-
-    Left: the speed |U| (absolute, all three components). Right: the in-plane (swirl) speed
-    with arrows of the in-plane velocity, which the axial throughflow would otherwise hide.
-    Lifters and points outside the shell are blank.
-    """
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    from matplotlib.patches import Circle, Polygon
-
-    from drumflow.geometry.lifters import all_plates
-
-    R, L = case.drum.radius, case.drum.length
-    z = 0.5 * L if z is None else float(z)
-    xs = np.linspace(-R, R, resolution)
-    X, Y = np.meshgrid(xs, xs, indexing="xy")
-    pts = np.column_stack([X.ravel(), Y.ravel(), np.full(X.size, z)])
-    U = air.sample(pts)
-    mask = ~fluid_mask_xy(case, X, Y)
-    speed = np.ma.array(np.linalg.norm(U, axis=1).reshape(X.shape), mask=mask)
-    swirl = np.ma.array(np.hypot(U[:, 0], U[:, 1]).reshape(X.shape), mask=mask)
-
-    fig, axes = plt.subplots(1, 2, figsize=(11, 5), dpi=120)
-    panels = ((speed, "|U| (m/s)"), (swirl, "in-plane speed (m/s)"))
-    for ax, (data, label) in zip(axes, panels, strict=True):
-        # Masked pixels (lifters) in the lifters' grey, and the image clipped to the shell:
-        # otherwise a pixel row of white shows beside each plate wherever its edge falls
-        # inside a pixel.
-        cmap = matplotlib.colormaps["viridis"].with_extremes(bad="0.35")
-        im = ax.imshow(
-            data, origin="lower", extent=(-R, R, -R, R), cmap=cmap, interpolation="nearest"
-        )
-        shell = Circle((0, 0), R, fill=False, lw=1.5, color="0.2")
-        ax.add_patch(shell)
-        im.set_clip_path(shell)
-        fig.colorbar(im, ax=ax, shrink=0.85, label=label)
-        for plate in all_plates(R, case.lifters):
-            corners = plate.corners()
-            r = np.hypot(corners[:, 0], corners[:, 1])
-            scale = np.minimum(1.0, R / np.maximum(r, 1e-300))
-            ax.add_patch(Polygon(corners * scale[:, None], closed=True, color="0.35"))
-        ax.set_xlim(-1.05 * R, 1.05 * R)
-        ax.set_ylim(-1.05 * R, 1.05 * R)
-        ax.set_aspect("equal")
-        ax.set_xlabel("x (m)")
-        ax.set_ylabel("y (m)")
-    step = max(1, resolution // 24)
-    sl = (slice(None, None, step), slice(None, None, step))
-    Ux = np.ma.array(U[:, 0].reshape(X.shape), mask=mask)[sl]
-    Uy = np.ma.array(U[:, 1].reshape(X.shape), mask=mask)[sl]
-    axes[1].quiver(X[sl], Y[sl], Ux, Uy, color="white", scale_units="xy", angles="xy",
-                   scale=float(max(np.ma.max(swirl), 1e-12)) / (0.08 * R), width=0.003)
-    model = air.meta.get("model", "?")
-    fig.suptitle(
-        f"{case.name}: air ({model}) at z = {z:.3g} m, drum frame, absolute velocity; "
-        f"{case.drum.rpm:g} rpm, mean axial {air.mean_axial_velocity():.3g} m/s towards -z",
-        fontsize=9,
-    )
-    fig.tight_layout()
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path)
-    plt.close(fig)

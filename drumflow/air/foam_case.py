@@ -200,13 +200,16 @@ def write_mrf(
         }
 
 
-def _field(
+def write_field(
     case_dir: Path,
     name: str,
     dims: dict[str, int],
     internal: float | list[float],
     boundary: dict[str, dict[str, Any]],
 ) -> None:
+    """Write the initial field ``0/NAME``: its dimensions (``dims`` as foamlib's
+    ``DimensionSet`` keywords, e.g. ``{"length": 1, "time": -1}``), a uniform internal value
+    and the boundary conditions by patch; an existing file is replaced, not merged."""
     from foamlib import FoamFieldFile, FoamFile
 
     path = case_dir / "0" / name
@@ -236,7 +239,7 @@ def write_initial_fields(
         The inlet ``k``, ``epsilon`` and ``mixing_length`` (0 for laminar).
     """
     zero = [0.0, 0.0, 0.0]
-    _field(
+    write_field(
         case_dir,
         "U",
         {"length": 1, "time": -1},
@@ -251,7 +254,7 @@ def write_initial_fields(
             "walls": {"type": "noSlip"},
         },
     )
-    _field(
+    write_field(
         case_dir,
         "p",
         {"length": 2, "time": -2},
@@ -265,7 +268,7 @@ def write_initial_fields(
     if turbulence == "laminar":
         return {"k": 0.0, "epsilon": 0.0, "mixing_length": 0.0}
     k, eps, lm = inlet_turbulence(bulk_velocity, hydraulic_diameter)
-    _field(
+    write_field(
         case_dir,
         "k",
         {"length": 2, "time": -2},
@@ -280,7 +283,7 @@ def write_initial_fields(
             "walls": {"type": "kqRWallFunction", "value": k},
         },
     )
-    _field(
+    write_field(
         case_dir,
         "epsilon",
         {"length": 2, "time": -3},
@@ -295,7 +298,7 @@ def write_initial_fields(
             "walls": {"type": "epsilonWallFunction", "value": eps},
         },
     )
-    _field(
+    write_field(
         case_dir,
         "nut",
         {"length": 2, "time": -1},
@@ -354,8 +357,8 @@ def write_decompose_dict(case_dir: Path, processes: int, axis: int = 0) -> None:
 
 def air_properties_for(case: Case) -> tuple[float, float]:
     """Air density (ideal gas at inlet p and T) and kinematic viscosity (air table), SI."""
-    from drumflow.air_properties import kinematic_viscosity
     from drumflow.geometry.fluid import air_density
+    from drumflow.physics.air import kinematic_viscosity
 
     return air_density(case), float(kinematic_viscosity(case.air.inlet_temperature_C))
 

@@ -24,7 +24,7 @@ OpenFOAM solution resampled, or plug flow), with the air's own flow, at every ai
 * **Particles and cells.** A particle gives its heat to, and sees the air of, the cell of its
   nearest fluid node (the smoothing length is the grid spacing, ``grid_spacing``); a particle
   beside a wall goes to the nearest fluid node. Positions are in the drum's frame, as the
-  velocity is sampled (:func:`~drumflow.air.field.rotate_to_drum_frame`).
+  velocity is sampled (:func:`~drumflow.physics.drum_frame.rotate_to_drum_frame`).
 
 The energy bookkeeping (:meth:`AirHeat.enthalpy_gain`) is the outlet's enthalpy flux against the
 inlet's, from the solved field: it equals the source to round-off by conservation, which the

@@ -34,7 +34,7 @@ voidage in it). Matching the two term by term::
     d = A (1 - eps)^2 / (eps^3 d_p^2),     f = 2 B (1 - eps) / (eps^3 d_p)
 
 with A = 150, B = 1.75 (:class:`ErgunLaw`). This law belongs with drumflow's other air-particle
-laws (:mod:`drumflow.coupling.physics`: Schiller-Naumann drag, Ranz-Marshall convection); it
+laws (:mod:`drumflow.physics.particle_air`: Schiller-Naumann drag, Ranz-Marshall convection); it
 is kept here until that module takes it, and it is the one place the Ergun constants live.
 
 Binning

@@ -10,8 +10,8 @@ import json
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
-from drumflow.air_properties import ideal_gas_density
 from drumflow.geometry.lifters import free_area
+from drumflow.physics.air import ideal_gas_density
 
 if TYPE_CHECKING:
     from drumflow.case import Case

@@ -29,8 +29,8 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from drumflow.air.source import FieldSource, mean_axial_velocity, uniform_field
-from drumflow.air_properties import ideal_gas_density
 from drumflow.geometry.lifters import free_area
+from drumflow.physics.air import ideal_gas_density
 from drumflow.readers import read_json_object
 
 if TYPE_CHECKING:
@@ -151,7 +151,8 @@ def _solve_into_cache(case: Case, rundir: RunDir, runner: Runner, inputs: AirInp
 
 
 def _run_cfd(case: Case, rundir: RunDir, runner: Runner, inputs: AirInputs) -> AirResult:
-    from drumflow.air.field import AirField, air_cache_key, plot_air_cross_section
+    from drumflow.air.field import AirField, air_cache_key
+    from drumflow.air.field_picture import plot_air_cross_section
 
     key = air_cache_key(case)
     cache = air_cache_dir() / key

@@ -6,7 +6,7 @@ bed as in the curtain, at the velocity of the air field where the particle sits;
 motion only enters through the slip velocity. So the mean temperature follows the lumped
 solution of one particle at the surface-mean Ranz-Marshall h of the particles' slip
 velocities (the same correlation and air state the coupling applies:
-:func:`drumflow.coupling.physics.ranz_marshall_h`). This module computes that h from a
+:func:`drumflow.physics.particle_air.ranz_marshall_h`). This module computes that h from a
 snapshot and an air field, with no solver:
 
 - :func:`sample_air_side` gives the h each particle sees, its mean over all particles, over
@@ -35,7 +35,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from drumflow.case import Case
-from drumflow.coupling.physics import AirState, ranz_marshall_h
+from drumflow.physics.particle_air import AirState, lumped_cooling, ranz_marshall_h
 
 #: Margin over the shell speed beyond which a downward-moving particle counts as airborne, m/s.
 AIRBORNE_MARGIN_M_S = 0.5
@@ -177,4 +177,4 @@ def lumped_mean_temperature(case: Case, h_w_m2k: Callable[[float], float] | floa
     else:
         hv = np.full(grid.shape, float(h_w_m2k))
     exponent = np.concatenate([[0.0], np.cumsum(0.5 * (hv[1:] + hv[:-1]) * np.diff(grid))]) * rate
-    return np.asarray(t_air + (t0 - t_air) * np.exp(-exponent[1:]), dtype=float)
+    return lumped_cooling(t0, t_air, exponent[1:])

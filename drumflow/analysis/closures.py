@@ -42,7 +42,6 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_valida
 from drumflow.analysis.air_side import airborne_mask
 from drumflow.analysis.observables import falling_mass_flow
 from drumflow.case import Case, load_case
-from drumflow.dem.dumps import dump_files, read_dump
 from drumflow.errors import BadFileError, RunDirectoryError
 from drumflow.readers import read_csv, read_json_object
 from drumflow.rundir import RunDir
@@ -289,7 +288,7 @@ def _uniform_air_velocity(case: Case) -> float:
     """Axial plug-flow speed of the case's air over the drum cross-section, m/s."""
     if case.air.model == "none" or case.air.mass_flow == 0:
         return 0.0
-    from drumflow.air_properties import ideal_gas_density
+    from drumflow.physics.air import ideal_gas_density
 
     rho = ideal_gas_density(case.air.inlet_temperature_C, case.air.pressure_kPa)
     return case.air.mass_flow / (rho * math.pi * case.drum.radius**2)
@@ -311,6 +310,10 @@ def extract_closures(run_dir: Path | str, start_s: float | None = None) -> Slice
     RunDirectoryError
         When a file is missing or the run has no falling particles or no snapshot in the window.
     """
+    # Reading a run's snapshots needs the DEM stage's reader; imported here so that the coolers,
+    # which only load a closures file, never load a simulation stage.
+    from drumflow.dem.dumps import dump_files, read_dump
+
     run = RunDir.existing(run_dir)
     root = run.root
     case_file = run.case_toml

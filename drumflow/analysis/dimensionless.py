@@ -13,7 +13,7 @@ Eq. 55   ``V_m = 4/3 pi (Dp/2)^3 N``
 =======  ==========================================================================
 
 Air properties (``k``, ``nu``, ``Pr``) are interpolated at ``T_ma`` from
-:mod:`drumflow.air_properties`. The mean air inlet velocity is, unless given,
+:mod:`drumflow.physics.air`. The mean air inlet velocity is, unless given,
 ``V_ai = mdot_a / (rho_air(T_ai) pi D^2 / 4)``, i.e. the air flow spread over the full drum
 cross-section (the paper does not give the inlet area it used).
 
@@ -30,26 +30,26 @@ the whole drum cross-section (above). For the paper's two models that gives 1844
 paper reports 3073 and 7686, 1.667 times more for both models (its Re implies v_max = 6.23 m/s
 against V_ai / Vf = 3.74 m/s here). Every Re drumflow computes, fits or compares is this one;
 the paper's Re and its Eq. 58 are converted to it once
-(:func:`drumflow.analysis.paper.reynolds_conversion`,
-:func:`drumflow.analysis.predict.paper_correlation`).
+(:func:`drumflow.analysis.published.reynolds_conversion`,
+:func:`drumflow.coolers.prediction.paper_correlation`).
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TypeVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from drumflow import air_properties as air
-from drumflow.analysis._validate import (
+from drumflow.physics import air
+from drumflow.physics.validation import (
     AnalysisInputError,
     as_float_array,
     check_finite,
     check_positive,
     check_same_length,
+    readonly,
 )
 
 __all__ = [
@@ -225,15 +225,6 @@ class DimensionlessSteps:
     valid: NDArray[np.bool_]
 
 
-_A = TypeVar("_A", bound=np.ndarray)
-
-
-def _readonly(arr: _A) -> _A:
-    # Frozen dataclass fields can still be mutated in place; lock the arrays too.
-    arr.setflags(write=False)
-    return arr
-
-
 def dimensionless_numbers(
     h_w_m2k: ArrayLike,
     air_temperature_c: ArrayLike,
@@ -326,15 +317,15 @@ def dimensionless_numbers(
     reynolds = v_max * dp / nu_air  # Eq. 51
 
     return DimensionlessSteps(
-        nusselt=_readonly(nusselt),
-        reynolds=_readonly(reynolds),
-        prandtl=_readonly(pr.astype(np.float64)),
-        mean_air_temperature_c=_readonly(t_ma),
-        conductivity_w_mk=_readonly(k.astype(np.float64)),
-        kinematic_viscosity_m2_s=_readonly(nu_air.astype(np.float64)),
+        nusselt=readonly(nusselt),
+        reynolds=readonly(reynolds),
+        prandtl=readonly(pr.astype(np.float64)),
+        mean_air_temperature_c=readonly(t_ma),
+        conductivity_w_mk=readonly(k.astype(np.float64)),
+        kinematic_viscosity_m2_s=readonly(nu_air.astype(np.float64)),
         void_fraction=vf,
         air_inlet_velocity_m_s=v_ai,
         max_air_velocity_m_s=v_max,
         particle_diameter_m=dp,
-        valid=_readonly(np.isfinite(nusselt)),
+        valid=readonly(np.isfinite(nusselt)),
     )

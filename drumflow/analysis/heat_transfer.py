@@ -39,32 +39,28 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TypeVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from drumflow.analysis._validate import (
+from drumflow.physics.exchanger import log_mean_temperature_difference
+from drumflow.physics.validation import (
     AnalysisInputError,
     as_float_array,
     check_finite,
     check_positive,
     check_same_length,
     exactly_one,
+    readonly,
 )
 
 __all__ = [
     "HeatTransferSteps",
     "falling_particle_area",
-    "log_mean_temperature_difference",
     "particle_mass",
     "per_step_heat_transfer",
 ]
 
-# Relative difference below which the two end differences of an exchanger are treated as equal:
-# the LMTD formula is 0/0 there and its limit (the common difference) is used instead. 1e-12 is
-# far below any physical significance yet well above double rounding of temperatures ~100.
-_EQUAL_ENDS_RTOL = 1e-12
 
 
 def particle_mass(particle_diameter_m: float, particle_density_kg_m3: float) -> float:
@@ -125,49 +121,6 @@ def falling_particle_area(
         return sphere_area / m_p * check_positive("falling_mass_kg", falling_mass_kg)
     m_mf = as_float_array("falling_mass_kg", falling_mass_kg, positive=True)
     return sphere_area / m_p * m_mf
-
-
-def log_mean_temperature_difference(
-    delta_a: ArrayLike, delta_b: ArrayLike
-) -> float | NDArray[np.float64]:
-    """Log-mean temperature difference of a counter-current exchanger, NaN where undefined.
-
-    ``LMTD = (dA - dB) / ln(dA / dB)`` with ``dA``, ``dB`` the hot-minus-cold temperature
-    differences at the two ends (Eqs. 38 and 47).
-
-    Parameters
-    ----------
-    delta_a, delta_b
-        End temperature differences (K or deg C), broadcastable arrays or scalars.
-
-    Returns
-    -------
-    float or numpy.ndarray
-        LMTD; where ``dA == dB`` (to a relative 1e-12) the limit ``dA``; NaN where either difference
-        is ``<= 0`` or not finite (log argument undefined: temperature cross). A float when both
-        inputs are scalars.
-    """
-    a = np.asarray(delta_a, dtype=np.float64)
-    b = np.asarray(delta_b, dtype=np.float64)
-    a, b = np.broadcast_arrays(a, b)
-    out = np.full(a.shape, np.nan)
-    ok = np.isfinite(a) & np.isfinite(b) & (a > 0.0) & (b > 0.0)
-    equal = ok & (np.abs(a - b) <= _EQUAL_ENDS_RTOL * np.maximum(np.abs(a), np.abs(b)))
-    general = ok & ~equal
-    # log1p((a-b)/b) == ln(a/b) but stays accurate when a and b are close, where the plain
-    # quotient would lose digits to cancellation.
-    out[general] = (a[general] - b[general]) / np.log1p((a[general] - b[general]) / b[general])
-    out[equal] = 0.5 * (a[equal] + b[equal])
-    return float(out) if out.ndim == 0 else out
-
-
-_A = TypeVar("_A", bound=np.ndarray)
-
-
-def _readonly(arr: _A) -> _A:
-    # Frozen dataclass fields can still be mutated in place; lock the arrays too.
-    arr.setflags(write=False)
-    return arr
 
 
 @dataclass(frozen=True)
@@ -350,19 +303,19 @@ def per_step_heat_transfer(
         h_mean = math.nan
 
     return HeatTransferSteps(
-        time_s=_readonly(t[1:].copy()),
-        dt_s=_readonly(dt),
-        particle_dT_c=_readonly(d_temp),
-        falling_mass_kg=_readonly(m_mf),
-        air_mass_kg=_readonly(m_a),
-        heat_j=_readonly(heat),
-        air_dT_c=_readonly(air_dt),
-        air_temperature_c=_readonly(air_t),
-        lmtd_c=_readonly(lmtd),
-        heat_rate_w=_readonly(rate),
-        area_m2=_readonly(area),
-        h_w_m2k=_readonly(h),
-        valid=_readonly(valid),
+        time_s=readonly(t[1:].copy()),
+        dt_s=readonly(dt),
+        particle_dT_c=readonly(d_temp),
+        falling_mass_kg=readonly(m_mf),
+        air_mass_kg=readonly(m_a),
+        heat_j=readonly(heat),
+        air_dT_c=readonly(air_dt),
+        air_temperature_c=readonly(air_t),
+        lmtd_c=readonly(lmtd),
+        heat_rate_w=readonly(rate),
+        area_m2=readonly(area),
+        h_w_m2k=readonly(h),
+        valid=readonly(valid),
         h_mean_w_m2k=h_mean,
         n_valid=n_valid,
         n_steps=n_steps,

@@ -5,7 +5,8 @@ How to use::
     drumflow answer RUN_DIR                  # writes RUN_DIR/post/answer.csv, .json, .png
     drumflow answer RUN_DIR --tolerance 0.02 --out /tmp/answer
 
-    from drumflow.bench.answer import replay_answer, write_answer
+    from drumflow.bench.answer import replay_answer
+    from drumflow.bench.answer_result import write_answer
     replay = replay_answer(Path("results/paper/model_two"))   # AnswerReplay
     replay.table[["time_s", "h_W_m2K", "rel_h", "converged"]]
     replay.first_fire_s, replay.settled_s
@@ -25,9 +26,9 @@ results folder with the same ``case.toml`` and ``post/`` files) at a grid of end
   column ``h_window_W_m2K`` gives the average over the window's steps alone. Their
   half-widths are batch means (:func:`drumflow.convergence.batch_means`) of the per-step
   series: ``h`` per step, and falling mass per step over its length. The falling mass cancels
-  from Eq. 39 but for the air's warming (:func:`drumflow.analysis.paper.eq39_as_lumped_h`), so
+  from Eq. 39 but for the air's warming (:func:`drumflow.analysis.published.eq39_as_lumped_h`), so
   the uncertainty of (b) hardly enters (c).
-* (a) is read from the series (:func:`drumflow.analysis.paper.temperature_at`) once ``t``
+* (a) is read from the series (:func:`drumflow.analysis.published.temperature_at`) once ``t``
   reaches 3.5 s. Before that it is extrapolated with the lumped balance
   ``T(3.5) = T_air + (T(t) - T_air) exp(-h_s A (3.5 - t) / (M c_p))``, where ``h_s`` is the
   stop rule's whole-surface coefficient averaged over the window so far (exact while ``h_s``
@@ -37,7 +38,7 @@ results folder with the same ``case.toml`` and ``post/`` files) at a grid of end
 * the verdict of ``run.stop = "converged"`` at ``t``: :func:`drumflow.convergence.decide` on
   the two intervals the online monitor forms (:meth:`drumflow.coupling.stop.StopMonitor.intervals`):
   ``h`` on the whole particle surface per coupling update from ``post/air_heat.csv`` and the
-  mean temperature (:func:`drumflow.analysis.paper.coupling_h`), and the falling mass flow from
+  mean temperature (:func:`drumflow.analysis.published.coupling_h`), and the falling mass flow from
   the crossings (``post/crossings.csv``) counted between consecutive updates. Besides the grid,
   the rule is checked the way the loop checks it (every output step) to find its first firing.
 
@@ -58,11 +59,8 @@ for that long). Set-up, the air solve and post-processing are not counted.
 
 from __future__ import annotations
 
-import json
 import math
-import os
 from collections.abc import Sequence
-from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -70,213 +68,52 @@ import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
-from drumflow._json import json_safe
-from drumflow.analysis.methodology import (
-    FallingMassMode,
-    MethodologyResult,
-    analyse_run,
-)
+from drumflow.analysis.methodology import analyse_run
+from drumflow.analysis.methodology_result import FallingMassMode, MethodologyResult
 from drumflow.analysis.observables import falling_mass_flow
-from drumflow.analysis.paper import coupling_h, temperature_at
-from drumflow.case import Case
-from drumflow.convergence import (
-    MSER_BATCH,
-    ConvergenceState,
-    MeanInterval,
-    batch_means,
-    decide,
-    mser_truncation,
+from drumflow.analysis.published import coupling_h, temperature_at
+from drumflow.bench.answer_result import QUANTITIES, TEMPERATURE_TIME_S, TIME_EPS_S, AnswerReplay
+from drumflow.bench.answer_rule import (
+    rule_check_every,
+    rule_first_fire,
+    rule_monitor,
+    rule_verdict,
 )
-from drumflow.coupling.log import measured_rate, read_coupling, update_walls
-from drumflow.coupling.stop import StopMonitor, min_stop_time, rule_inputs
+from drumflow.bench.answer_wall import wall_per_update
+from drumflow.case import Case
+from drumflow.convergence import MSER_BATCH, batch_means, mser_truncation
+from drumflow.coupling.stop import StopMonitor, min_stop_time
 from drumflow.errors import (
     AnalysisInputError,
-    BadFileError,
     MissingRunFileError,
     NoHeatTransferError,
     RunDirectoryError,
     RunTooShortError,
 )
-from drumflow.readers import read_csv, read_json_object
+from drumflow.readers import read_csv
 from drumflow.rundir import RunDir
 
 __all__ = [
     "DEFAULT_CHECK_INTERVAL_S",
     "DEFAULT_TOLERANCE",
     "MIN_WINDOW_S",
-    "QUANTITIES",
-    "TEMPERATURE_TIME_S",
-    "AnswerReplay",
-    "plot_answer",
+    "regular_end_times",
     "replay_answer",
     "settled_time",
-    "write_answer",
 ]
 
 #: Largest relative difference from the full run at which the answer counts as known (issue 11).
 DEFAULT_TOLERANCE = 0.01
 #: Grid of end times, simulated seconds.
 DEFAULT_CHECK_INTERVAL_S = 0.1
-#: Tables 3-4 of the paper read the mean particle temperature at this time.
-TEMPERATURE_TIME_S = 3.5
 #: Least simulated time after ``run.mass_flow_start`` a run must hold to be replayed: below one
 #: second the falling mass flow has seen about one lifter's discharge (paper model two: 12
 #: lifters at 5 rpm, one per second).
 MIN_WINDOW_S = 1.0
-#: The answer's three quantities: column of the value, and its label.
-QUANTITIES = {"temperature": ("temperature_C", "(a) mean temperature at 3.5 s"),
-              "mass_flow": ("mass_flow_kg_s", "(b) falling mass flow"),
-              "h": ("h_W_m2K", "(c) h, Eq. 39")}
-
-# Output and update times are multiples of the DEM step (~1e-4 s) written with 10 significant
-# digits, a few 1e-9 s off at 17.5 s; 1e-6 s tells them apart from their neighbours safely.
-_TIME_EPS_S = 1e-6
-_RUN_RECORD = "run_record.json"
 #: Columns of the run's tables that must hold a finite number in every row (the first row's
 #: falling mass is NaN by construction: no step ends there).
 _SERIES_FINITE = ("time_s", "mean_temperature_C")
 _AIR_HEAT_FINITE = ("step", "time_s", "steps", "heat_to_particles_W")
-
-
-@dataclass(frozen=True)
-class AnswerReplay:
-    """What a run stopped at each grid time would have reported, and when its answer settled.
-
-    Attributes
-    ----------
-    run_dir
-        The replayed directory (absolute).
-    case
-        Its case.
-    table
-        One row per grid time (the last row is the reference). Columns: ``time_s`` (the output
-        time a run stopped there ends at); ``temperature_C``, ``temperature_half_width_K``,
-        ``temperature_extrapolated``; ``mass_flow_kg_s``, ``mass_flow_half_width_kg_s``;
-        ``h_W_m2K``, ``h_half_width_W_m2K``, ``h_window_W_m2K``; ``eq57_mass_flow_kg_s`` (Eq. 57
-        from the crossings, first to last); the stop rule's ``monitor_h_W_m2K``,
-        ``monitor_h_rel_half_width``, ``monitor_mass_flow_kg_s``,
-        ``monitor_mass_flow_rel_half_width``, ``converged``, ``intervals_within_tolerance``
-        (the same verdict without the minimum time), ``reason``; ``rel_temperature``,
-        ``rel_temperature_drop``, ``rel_mass_flow``, ``rel_h``; ``steady_mass_flow_kg_s``,
-        ``steady_mass_flow_half_width_kg_s``, ``steady_start_s`` (the falling mass flow from the
-        end of the start-up transient, :func:`_steady_mass_flow`) and
-        ``rel_steady_mass_flow``; ``wall_s`` (cumulative) and
-        ``wall_estimated_share`` (share of it from the rate, not measured).
-    reference_time_s
-        The end time the relative differences refer to: the last output time of the run.
-    planned_time_s
-        The case's ``run.time`` (the full run the answer is meant to match).
-    tolerance
-        The stop rule's tolerance (largest relative half-width).
-    settle_tolerance
-        Largest relative difference from the reference for "settled".
-    min_stop_time_s
-        The rule's minimum time (:func:`drumflow.coupling.stop.min_stop_time`).
-    check_every_steps
-        DEM steps between the rule's checks (the output step).
-    first_fire_s
-        First time the rule fires, checked as the coupling loop checks it; None if never.
-    first_fire_grid_s
-        First grid time at which it fires; None if never.
-    first_fire_reason
-        The verdict's line at ``first_fire_s`` (or at the reference when it never fires).
-    at_first_fire
-        Values and relative differences a run stopped at ``first_fire_s`` reports (empty if
-        the rule never fires).
-    settled_s
-        Per quantity (``temperature``, ``mass_flow``, ``h``, ``temperature_drop``,
-        ``steady_mass_flow``: the cascading bed's flow after MSER's cut of the window): the first
-        grid time from which it stays within ``settle_tolerance``; None if not even the
-        reference qualifies.
-    wall
-        How the wall times were obtained: ``source`` (``measured``, ``rate``,
-        ``measured+rate``, or ``none``: no wall times and no rate, ``wall_s`` NaN),
-        ``particle_steps_per_s``, ``rate_source``, ``measured_updates``,
-        ``estimated_updates``, ``total_s`` (up to the reference).
-    notes
-        Remarks (the reference is not the planned end, the rule cannot fire yet, ...).
-    """
-
-    run_dir: Path
-    case: Case
-    table: pd.DataFrame
-    reference_time_s: float
-    planned_time_s: float
-    tolerance: float
-    settle_tolerance: float
-    min_stop_time_s: float
-    check_every_steps: int
-    first_fire_s: float | None
-    first_fire_grid_s: float | None
-    first_fire_reason: str
-    at_first_fire: dict[str, Any]
-    settled_s: dict[str, float | None]
-    wall: dict[str, Any]
-    notes: tuple[str, ...] = field(default=())
-
-    @property
-    def reference(self) -> pd.Series:
-        """The reference row of :attr:`table`."""
-        return self.table.iloc[-1]
-
-    @property
-    def answer_settled_s(self) -> float | None:
-        """When all three quantities (a), (b), (c) have settled; None if one never does."""
-        times = [self.settled_s[name] for name in QUANTITIES]
-        return None if any(t is None for t in times) else max(t for t in times if t is not None)
-
-    def wall_at(self, time_s: float | None) -> float | None:
-        """Cumulative wall time at a grid time, or at the first firing (None for None)."""
-        if time_s is None:
-            return None
-        if self.first_fire_s is not None and abs(time_s - self.first_fire_s) < _TIME_EPS_S:
-            return _finite_or_none(self.at_first_fire.get("wall_s"))
-        rows = self.table[np.abs(self.table["time_s"] - time_s) < _TIME_EPS_S]
-        return None if rows.empty else _finite_or_none(rows["wall_s"].iloc[0])
-
-    def to_dict(self) -> dict[str, Any]:
-        """JSON-ready summary (NaN as ``null``); the per-time table is not included."""
-        ref = self.reference
-        values = {name: float(ref[col]) for name, (col, _) in QUANTITIES.items()}
-        half = {"temperature": float(ref["temperature_half_width_K"]),
-                "mass_flow": float(ref["mass_flow_half_width_kg_s"]),
-                "h": float(ref["h_half_width_W_m2K"])}
-        settled = self.answer_settled_s
-        return json_safe({
-            "run_dir": str(self.run_dir),
-            "case": self.case.name,
-            "reference": {
-                "time_s": self.reference_time_s,
-                "source": "the longest time available: the last output time of "
-                          "post/mean_temperature.csv",
-                "planned_time_s": self.planned_time_s,
-                "values": values,
-                "half_widths": half,
-                "h_window_W_m2K": float(ref["h_window_W_m2K"]),
-                "eq57_mass_flow_kg_s": float(ref["eq57_mass_flow_kg_s"]),
-                "steady_mass_flow_kg_s": float(ref["steady_mass_flow_kg_s"]),
-                "steady_mass_flow_half_width_kg_s": float(ref["steady_mass_flow_half_width_kg_s"]),
-                "steady_start_s": float(ref["steady_start_s"]),
-            },
-            "temperature_time_s": TEMPERATURE_TIME_S,
-            "settle_tolerance": self.settle_tolerance,
-            "settled_s": self.settled_s,
-            "answer_settled_s": settled,
-            "wall_at_answer_settled_s": self.wall_at(settled),
-            "rule": {
-                "tolerance": self.tolerance,
-                "min_time_s": self.min_stop_time_s,
-                "check_every_steps": self.check_every_steps,
-                "first_fire_s": self.first_fire_s,
-                "first_fire_grid_s": self.first_fire_grid_s,
-                "reason": self.first_fire_reason,
-                "wall_at_first_fire_s": self.wall_at(self.first_fire_s),
-                "at_first_fire": self.at_first_fire,
-            },
-            "wall": self.wall,
-            "grid_times": int(len(self.table)),
-            "notes": list(self.notes),
-        })
 
 
 def settled_time(times: Sequence[float] | NDArray[np.float64],
@@ -389,7 +226,7 @@ def replay_answer(
     out_t = temps["time_s"].to_numpy(float)
     end = float(out_t[-1])
     start = float(case.run.mass_flow_start)
-    if end < start + MIN_WINDOW_S - _TIME_EPS_S:
+    if end < start + MIN_WINDOW_S - TIME_EPS_S:
         raise RunTooShortError(run.mean_temperature_csv, end, start + MIN_WINDOW_S,
                                f"run.mass_flow_start = {start:g} s plus {MIN_WINDOW_S:g} s")
     grid = _grid(out_t, start, check_interval_s, times)
@@ -398,12 +235,12 @@ def replay_answer(
     # Checked: a cut .csv.gz ended in gzip's EOFError, which click turns into a bare "Aborted."
     crossings = read_csv(run.crossings_table, "the particles crossing the axis plane",
                          columns=("time",), finite=("time",))
-    monitor = _monitor(case, run, updates, crossings, dt)
-    wall, wall_info = _wall_per_update(run, updates, dt, particle_steps_per_s)
+    monitor = rule_monitor(case, run, updates, crossings, dt)
+    wall, wall_info = wall_per_update(run, updates, dt, particle_steps_per_s)
     notes: list[str] = []
 
     min_time = min(min_stop_time(case), float(case.run.time))
-    rows = [_row(t, case, run, full if t >= end - _TIME_EPS_S else None, falling_mass, temps,
+    rows = [_row(t, case, run, full if t >= end - TIME_EPS_S else None, falling_mass, temps,
                  crossings, updates, monitor, wall, tolerance, min_time, notes) for t in grid]
     table = pd.DataFrame(rows)
     ref = table.iloc[-1]
@@ -415,8 +252,8 @@ def replay_answer(
     table["rel_steady_mass_flow"] = (table["steady_mass_flow_kg_s"]
                                      / float(ref["steady_mass_flow_kg_s"]) - 1.0)
 
-    every = _check_every(run, out_t, dt)
-    first_fire, reason = _first_fire(monitor, updates, out_t, every, tolerance, min_time)
+    every = rule_check_every(run, out_t, dt)
+    first_fire, reason = rule_first_fire(monitor, updates, out_t, every, tolerance, min_time)
     fired = table.loc[table["converged"], "time_s"]
     at_fire: dict[str, Any] = {}
     if first_fire is not None:
@@ -435,17 +272,17 @@ def replay_answer(
     planned = float(case.run.time)
     late = float(grid[-2]) if grid.size > 1 else end
     for name, when in settled.items():
-        if when is None or when >= late - _TIME_EPS_S:
+        if when is None or when >= late - TIME_EPS_S:
             notes.append(f"{name} settles only at the end of the replay ({late:.4g} s or later): "
                          "it still drifts, so the run is too short to tell its answer")
-    if end < planned - _TIME_EPS_S:
+    if end < planned - TIME_EPS_S:
         notes.append(f"the reference is the run's last output at {end:.4g} s, not the planned "
                      f"run.time = {planned:g} s: settled times are relative to it")
-    if end < min_time - _TIME_EPS_S:
+    if end < min_time - TIME_EPS_S:
         notes.append(f"the rule cannot fire before its minimum time {min_time:.4g} s "
                      f"(run.stop_min_time = {case.run.stop_min_time!r}); the run ends at "
                      f"{end:.4g} s")
-    if end < TEMPERATURE_TIME_S - _TIME_EPS_S:
+    if end < TEMPERATURE_TIME_S - TIME_EPS_S:
         notes.append(f"the run ends before {TEMPERATURE_TIME_S:g} s: (a) is extrapolated at "
                      "every time, the reference too")
     if table["temperature_extrapolated"].any():
@@ -477,21 +314,21 @@ def _grid(out_t: NDArray[np.float64], start: float, every: float,
         targets = regular_end_times(start, end, every)
     else:
         targets = np.asarray(list(times), dtype=float)
-        bad = targets[~np.isfinite(targets) | (targets <= start) | (targets > end + _TIME_EPS_S)]
+        bad = targets[~np.isfinite(targets) | (targets <= start) | (targets > end + TIME_EPS_S)]
         if bad.size:
             raise AnalysisInputError("times", float(bad[0]),
                                      f"end times in ({start:g}, {end:.10g}] s "
                                      "(after run.mass_flow_start, up to the end of the run)")
-    at = np.searchsorted(out_t, targets + _TIME_EPS_S, side="right") - 1
+    at = np.searchsorted(out_t, targets + TIME_EPS_S, side="right") - 1
     snapped = out_t[at[at >= 0]]
-    snapped = snapped[snapped > start + _TIME_EPS_S]
+    snapped = snapped[snapped > start + TIME_EPS_S]
     return np.unique(np.concatenate([snapped, [end]]))
 
 
 def _updates(case: Case, run: RunDir, temps: pd.DataFrame,
              end: float) -> tuple[pd.DataFrame, float]:
     """The coupling updates up to the end of the temperature series, with the whole-surface h
-    the stop rule uses (:func:`drumflow.analysis.paper.coupling_h`), and the DEM time step."""
+    the stop rule uses (:func:`drumflow.analysis.published.coupling_h`), and the DEM time step."""
     air_heat = read_csv(run.air_heat_csv, "the heat the air took at each coupling update",
                         columns=_AIR_HEAT_FINITE, finite=_AIR_HEAT_FINITE, min_rows=1)
     try:
@@ -505,83 +342,7 @@ def _updates(case: Case, run: RunDir, temps: pd.DataFrame,
     dt = float(np.median(table["time_s"].to_numpy(float)[step > 0] / step[step > 0]))
     table["held_s"] = table["steps"].to_numpy(float) * dt
     # A run stopped part way logged one update past its last output; it has no temperature.
-    return table[table["time_s"] <= end + _TIME_EPS_S].reset_index(drop=True), dt
-
-
-def _monitor(case: Case, run: RunDir, updates: pd.DataFrame, crossings: pd.DataFrame,
-             dt: float) -> StopMonitor:
-    """The online monitor, fed the replayed series instead of live particles.
-
-    It is made as a rank other than 0, which writes nothing, so the replay reads the run
-    directory only; :meth:`StopMonitor.windowed` then builds the rule's two series exactly as
-    the coupling loop does.
-    """
-    # The DEM's case: with coarse-graining, what crossed were parcels.
-    rule = rule_inputs(case.dem_case(), case.run.time, check_every=1)
-    monitor = StopMonitor(rule, run.dem, rank=1, time_step=dt, start_step=0)
-    t_upd = updates["time_s"].to_numpy(float)
-    # Crossing sample k counts the crossings in (t_{k-1}, t_k], as the loop's tracker does.
-    at = np.searchsorted(t_upd, crossings["time"].to_numpy(float), side="left")
-    inside = (at > 0) & (at < t_upd.size)
-    counts = np.bincount(at[inside], minlength=t_upd.size).astype(float)
-    counts[0] = math.nan  # the first update has no previous sample
-    s = monitor.series
-    s.step = [int(v) for v in updates["step"]]
-    s.time_s = [float(v) for v in t_upd]
-    s.steps = [int(v) for v in updates["steps"]]
-    s.h = [float(v) for v in updates["h_W_m2K"]]
-    s.crossings = [float(v) for v in counts]
-    return monitor
-
-
-def _verdict(monitor: StopMonitor, n: int, time_s: float, tolerance: float,
-             min_time: float) -> tuple[ConvergenceState, bool, MeanInterval]:
-    """The rule at ``time_s`` on the first ``n`` updates, whether its intervals alone pass, and
-    the whole-surface h over the window so far (batch means of every sample, whole cycles or
-    not: the temperature's extrapolation needs it before the first cycle ends)."""
-    full = monitor.series
-    monitor.series = replace(full, step=full.step[:n], time_s=full.time_s[:n],
-                             steps=full.steps[:n], h=full.h[:n], crossings=full.crossings[:n])
-    try:
-        intervals = monitor.intervals()
-        h_window = batch_means(*monitor.windowed()["h_W_m2K"])
-    finally:
-        monitor.series = full
-    state = decide(intervals, time_s, tolerance, min_time)
-    narrow = decide(intervals, time_s, tolerance, -math.inf).converged
-    return state, narrow, h_window
-
-
-def _check_every(run: RunDir, out_t: NDArray[np.float64], dt: float) -> int:
-    """DEM steps between the rule's checks: the output step (``drumflow.dem.stage``)."""
-    recorded = run.manifest.get("output_every")
-    if recorded:
-        return int(recorded)
-    return max(1, int(round(float(np.median(np.diff(out_t))) / dt)))
-
-
-def _first_fire(monitor: StopMonitor, updates: pd.DataFrame, out_t: NDArray[np.float64],
-                every: int, tolerance: float, min_time: float) -> tuple[float | None, str]:
-    """The first check at which the rule fires, on the loop's schedule (an update whose step
-    is at least ``every`` after the previous check's), as the output time it stops at."""
-    steps = updates["step"].to_numpy(int)
-    t_upd = updates["time_s"].to_numpy(float)
-    last, state = 0, None
-    for i, step in enumerate(steps):
-        if step - last < every:
-            continue
-        last = int(step)
-        if t_upd[i] < min_time - _TIME_EPS_S:
-            continue
-        state, _, _ = _verdict(monitor, i + 1, float(t_upd[i]), tolerance, min_time)
-        if state.converged:
-            # The output written at that step (the same time, to its 10 digits).
-            near = int(np.argmin(np.abs(out_t - t_upd[i])))
-            return float(out_t[near] if abs(out_t[near] - t_upd[i]) < _TIME_EPS_S
-                         else t_upd[i]), state.reason
-    if state is None:
-        state, _, _ = _verdict(monitor, len(steps), float(t_upd[-1]), tolerance, min_time)
-    return None, f"never fired; at {state.time_s:.4g} s: {state.reason}"
+    return table[table["time_s"] <= end + TIME_EPS_S].reset_index(drop=True), dt
 
 
 def _row(t: float, case: Case, run: RunDir, result: MethodologyResult | None,
@@ -617,14 +378,14 @@ def _row(t: float, case: Case, run: RunDir, result: MethodologyResult | None,
             h_window_W_m2K=(float(np.sum(h[in_h] * dt_step[in_h]) / np.sum(dt_step[in_h]))
                             if in_h.any() else math.nan),
         )
-    upto = crossings[crossings["time"] <= t + _TIME_EPS_S]
+    upto = crossings[crossings["time"] <= t + TIME_EPS_S]
     eq57 = falling_mass_flow(upto, float(monitor.rule["particle_mass_kg"]), start=start)
     row["eq57_mass_flow_kg_s"] = eq57.mass_flow_kg_s if eq57.crossings >= 2 else math.nan
     row.update(_steady_mass_flow(temps, start, t))
 
     # The stop rule on the updates up to t.
-    n = int(np.searchsorted(updates["time_s"].to_numpy(float), t + _TIME_EPS_S, side="right"))
-    state, narrow, h_window = _verdict(monitor, n, t, tolerance, min_time)
+    n = int(np.searchsorted(updates["time_s"].to_numpy(float), t + TIME_EPS_S, side="right"))
+    state, narrow, h_window = rule_verdict(monitor, n, t, tolerance, min_time)
     h_iv = state.intervals["h_W_m2K"]
     m_iv = state.intervals["falling_mass_flow_kg_s"]
     row.update(monitor_h_W_m2K=h_iv.mean, monitor_h_rel_half_width=h_iv.relative_half_width,
@@ -649,7 +410,7 @@ def _row(t: float, case: Case, run: RunDir, result: MethodologyResult | None,
                    temperature_extrapolated=True)
     # Wall time of the updates that ended by t.
     done = (updates["time_s"].to_numpy(float) + updates["held_s"].to_numpy(float)
-            <= t + _TIME_EPS_S)
+            <= t + TIME_EPS_S)
     row["wall_s"] = float(np.sum(wall[done, 0] + wall[done, 1]))
     row["wall_estimated_share"] = (float(np.sum(wall[done, 1]) / row["wall_s"])
                                    if row["wall_s"] > 0 else math.nan)
@@ -666,7 +427,7 @@ def _steady_mass_flow(temps: pd.DataFrame, start: float, t: float) -> dict[str, 
     times = temps["time_s"].to_numpy(float)
     mass = temps["falling_mass_kg_in_step"].to_numpy(float)
     # Row k holds the mass fallen in (t_{k-1}, t_k]: in the window when that interval is.
-    inside = (np.r_[np.nan, times[:-1]] >= start - _TIME_EPS_S) & (times <= t + _TIME_EPS_S)
+    inside = (np.r_[np.nan, times[:-1]] >= start - TIME_EPS_S) & (times <= t + TIME_EPS_S)
     inside &= np.isfinite(mass)
     gaps = np.r_[np.nan, np.diff(times)][inside]
     rate = mass[inside] / gaps
@@ -680,81 +441,6 @@ def _steady_mass_flow(temps: pd.DataFrame, start: float, t: float) -> dict[str, 
             "steady_start_s": float(times[inside][cut] - gaps[cut])}
 
 
-def _wall_per_update(run: RunDir, updates: pd.DataFrame, dt: float,
-                     rate: float | None) -> tuple[NDArray[np.float64], dict[str, Any]]:
-    """Per update: measured wall seconds (column 0) and estimated ones (column 1), one of them
-    zero; and how they were obtained."""
-    measured = np.full(len(updates), math.nan)
-    logged = pd.DataFrame()
-    paused_updates = 0
-    folder = run.dem_coupling_logs
-    if folder.is_dir() and any(folder.glob("rank*.csv")):
-        logs = update_walls(read_coupling(folder, dt))
-        if not logs.empty:
-            # The logs may reach past the post-processed series (a run still going): every
-            # logged update gives the rate, those in the series their own wall time.
-            # A process stopped from outside (SIGSTOP, a suspended laptop, a pre-empted node)
-            # logs the pause in the update it interrupted: hours against seconds. Such an
-            # update is not the code's speed; it is estimated from the rate like an unlogged one.
-            paused_updates = int(logs["paused"].sum())
-            logged = logs[~logs["paused"].astype(bool)]
-            per_step = dict(zip(logged["step"].to_numpy(int), logged["wall_s"].to_numpy(float),
-                                strict=True))
-            measured = np.array([per_step.get(int(s), math.nan) for s in updates["step"]])
-    work = updates["particles"].to_numpy(float) * updates["steps"].to_numpy(float)
-    have = np.isfinite(measured)
-    rate_source = "argument particle_steps_per_s"
-    if rate is None and not logged.empty:
-        rate = measured_rate(logged)
-        rate_source = (f"the {len(logged)} coupling updates with logged wall times "
-                       f"({float(logged['time_s'].min()):.4g}-{float(logged['time_s'].max()):.4g} s "
-                       "simulated): the speed of the code that ran them")
-    if rate is None:
-        rate, rate_source = _rate_from_record(run, updates)
-    estimated = np.where(have, 0.0, work / rate if rate else math.nan)
-    wall = np.column_stack([np.where(have, measured, 0.0), estimated])
-    source = ("measured" if have.all() else "none" if rate is None
-              else "rate" if not have.any() else "measured+rate")
-    info: dict[str, Any] = {
-        "source": source, "particle_steps_per_s": rate,
-        "rate_source": rate_source if not have.all() else "not used",
-        "measured_updates": int(have.sum()), "estimated_updates": int((~have).sum()),
-        "logged_updates_with_wall_times": len(logged),
-        "paused_updates": paused_updates,
-        "counts": "python_wall_s + liggghts_wall_s of the slowest rank per coupling update; "
-                  "no set-up, air solve or post-processing"}
-    if not logged.empty:
-        info["logged_wall_s_per_simulated_s"] = (float(logged["wall_s"].sum())
-                                                 / (float(logged["steps"].sum()) * dt))
-    return wall, info
-
-
-def _rate_from_record(run: RunDir, updates: pd.DataFrame) -> tuple[float | None, str]:
-    """Particle-steps per wall second of a shipped run, from its ``run_record.json``."""
-    path = run.root / _RUN_RECORD
-    if not path.is_file():
-        return None, "none: no wall times logged and no run_record.json"
-    what = "the shipped run's timings"
-    record = read_json_object(path, what)
-    wall = record.get("dem_wall_time_s")
-    simulated = record.get("simulated_time_s")
-    if not wall or not simulated:
-        return None, f"none: {path.name} has no dem_wall_time_s"
-    for name, value in (("dem_wall_time_s", wall), ("simulated_time_s", simulated)):
-        # A NaN is truthy: it would give every estimated wall time as NaN, in silence.
-        if (not isinstance(value, int | float) or isinstance(value, bool)
-                or not math.isfinite(value) or value <= 0):
-            raise BadFileError(path, f"{name} = {value!r}: expected a positive number of "
-                               "seconds", what)
-    t_upd = updates["time_s"].to_numpy(float)
-    done = t_upd < float(simulated) - _TIME_EPS_S
-    work = float(np.sum(updates["particles"].to_numpy(float)[done]
-                        * updates["steps"].to_numpy(float)[done]))
-    return work / float(wall), (f"{path.name}: dem_wall_time_s = {float(wall):.6g} s over "
-                                f"{float(simulated):.4g} s simulated "
-                                f"({record.get('dem_wall_time_source', 'DEM wall time')})")
-
-
 def _merge_no_h(notes: list[str]) -> tuple[str, ...]:
     """One note for the early times without h (they give the same reason), then the rest."""
     early = [n for n in notes if n.startswith("no h at ")]
@@ -764,83 +450,3 @@ def _merge_no_h(notes: list[str]) -> tuple[str, ...]:
         rest.insert(0, f"no h at {times} s (the methodology raised NoHeatTransferError; at the "
                        f"first: {early[0].split(': ', 1)[-1]})")
     return tuple(dict.fromkeys(rest))
-
-
-def _finite_or_none(value: Any) -> float | None:
-    try:
-        f = float(value)
-    except (TypeError, ValueError):
-        return None
-    return f if math.isfinite(f) else None
-
-
-# -- output ---------------------------------------------------------------------------------
-def plot_answer(replay: AnswerReplay, path: Path, title: str = "") -> None:
-    """|relative difference| from the reference of (a), (b), (c) against simulated time (log
-    axis), the settle band and the rule's first firing."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    table = replay.table
-    t = table["time_s"].to_numpy(float)
-    fig, ax = plt.subplots(figsize=(7.5, 4.4), dpi=120)
-    floor = 1e-6
-    for (name, (_, label)), colour in zip(QUANTITIES.items(), ("tab:red", "tab:blue", "tab:green"),
-                                         strict=True):
-        rel = np.abs(table[f"rel_{name}"].to_numpy(float))
-        # The reference is 0 by definition: drawn at the floor of the axis.
-        ax.plot(t, np.clip(rel, floor, None), marker=".", lw=1.3, color=colour, label=label)
-        when = replay.settled_s.get(name)
-        if when is not None:
-            ax.axvline(when, color=colour, lw=0.8, ls=":")
-    steady = np.abs(table["rel_steady_mass_flow"].to_numpy(float))
-    if np.isfinite(steady).any():
-        ax.plot(t, np.clip(steady, floor, None), marker=".", lw=1.3, color="tab:purple",
-                label="(b') falling mass flow of the cascading bed (MSER window)")
-        when = replay.settled_s.get("steady_mass_flow")
-        if when is not None:
-            ax.axvline(when, color="tab:purple", lw=0.8, ls=":")
-    ax.axhspan(floor, replay.settle_tolerance, color="0.9", zorder=0,
-               label=f"within {replay.settle_tolerance:.0%} (settled times dotted)")
-    ax.axhline(replay.settle_tolerance, color="0.4", lw=0.8)
-    if replay.first_fire_s is not None:
-        ax.axvline(replay.first_fire_s, color="black", lw=1.4, ls="--",
-                   label=f"stop rule fires ({replay.tolerance:.0%}): {replay.first_fire_s:.3g} s")
-    else:
-        ax.plot([], [], color="black", ls="--",
-                label=f"stop rule ({replay.tolerance:.0%}) never fires by {replay.reference_time_s:.3g} s")
-    ax.axvline(replay.min_stop_time_s, color="0.5", lw=0.8, ls="-.",
-               label=f"rule's minimum time {replay.min_stop_time_s:.3g} s")
-    ax.set_yscale("log")
-    ax.set_ylim(floor, max(1.0, float(np.nanmax(np.abs(table[[f"rel_{n}" for n in QUANTITIES]]
-                                                             .to_numpy(float)))) * 1.5))
-    ax.set_xlabel("simulated time at which the run stops (s)")
-    ax.set_ylabel(f"|value / value at {replay.reference_time_s:.3g} s - 1|")
-    ax.set_title(title or f"{replay.case.name}: time to answer", fontsize=9)
-    ax.legend(fontsize=7, loc="upper right")
-    fig.tight_layout()
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, bbox_inches="tight")
-    plt.close(fig)
-
-
-def path_from(folder: Path, path: Path | str) -> str:
-    """``path`` as written in a results file kept in ``folder``: relative to it, so a shipped
-    file names its run the same in every checkout."""
-    return os.path.relpath(Path(path).resolve(), Path(folder).resolve())
-
-
-def write_answer(replay: AnswerReplay, folder: Path, title: str = "") -> dict[str, Path]:
-    """Write ``answer.csv`` (per end time), ``answer.json`` and ``answer.png`` into ``folder``
-    (created if missing); return their paths by name."""
-    folder.mkdir(parents=True, exist_ok=True)
-    paths = {"table": folder / "answer.csv", "summary": folder / "answer.json",
-             "plot": folder / "answer.png"}
-    replay.table.to_csv(paths["table"], index=False, float_format="%.10g")
-    summary = replay.to_dict()
-    summary["run_dir"] = path_from(folder, replay.run_dir)
-    paths["summary"].write_text(json.dumps(summary, indent=2, allow_nan=False) + "\n")
-    plot_answer(replay, paths["plot"], title)
-    return paths

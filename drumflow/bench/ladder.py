@@ -11,7 +11,6 @@ the moving-mesh shell.
 from __future__ import annotations
 
 import copy
-import math
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
@@ -167,11 +166,3 @@ def select(rungs: list[Rung], names: list[str] | None, speed_only: bool = False)
     wanted = set(names) if speed_only else set(names) | {REFERENCE}
     wanted |= {r.base for r in rungs if r.name in wanted and r.base}
     return [r for r in rungs if r.name in wanted]
-
-
-def relative_error(value: float, reference: float) -> float:
-    """|value - reference| / |reference| (NaN when either is missing or the reference is 0)."""
-    if (value is None or reference is None or not math.isfinite(value)
-            or not math.isfinite(reference) or reference == 0):
-        return math.nan
-    return abs(value - reference) / abs(reference)

@@ -8,6 +8,8 @@ import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
+from drumflow._mpl import pyplot
+
 
 def pareto_front(cost: NDArray[np.float64], error: NDArray[np.float64]) -> NDArray[np.bool_]:
     """Which points no other point beats on both cost and error (ties kept).
@@ -28,10 +30,7 @@ def pareto_front(cost: NDArray[np.float64], error: NDArray[np.float64]) -> NDArr
 
 def plot_pareto(table: pd.DataFrame, path: Path, tolerances: dict[str, float], title: str) -> None:
     """Wall time of the DEM stage against the worst error over its tolerance, one point per rung."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     ok = table[(table["status"] == "ok") & table["dem_wall_time_s"].notna()].copy()
     fig, ax = plt.subplots(figsize=(8.0, 5.5), dpi=120)

@@ -40,6 +40,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from drumflow._mpl import pyplot
 from drumflow.coupling.log import WALL_COLUMNS, read_coupling
 from drumflow.dem.thermo import LOOP_TIME
 from drumflow.errors import BadFileError, RunDirectoryError
@@ -428,10 +429,7 @@ _STACK = (("share_pair", "pair", "tab:blue"), ("share_neigh", "neighbour lists",
 def plot_profile(profile: RunProfile, path: Path, title: str = "") -> None:
     """Stacked shares of each sampled interval's wall time against simulated time, and the
     particle-steps per second on a second axis."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     table = profile.intervals
     t = 0.5 * (table["start_time_s"] + table["end_time_s"]).to_numpy(float)

@@ -40,11 +40,11 @@ from drumflow.bench.ladder import (
     Rung,
     apply_rung,
     ladder,
-    relative_error,
     select,
 )
 from drumflow.bench.pareto import pareto_front, plot_pareto
 from drumflow.errors import CaseError, DrumflowError
+from drumflow.physics.validation import relative_error
 from drumflow.readers import read_json_object
 from drumflow.rundir import RunDir
 from drumflow.runner import Runner

@@ -47,14 +47,14 @@ from numpy.typing import NDArray
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
 from drumflow._json import json_safe
+from drumflow._mpl import pyplot
 from drumflow.bench.answer import (
     DEFAULT_TOLERANCE,
-    AnswerReplay,
-    path_from,
     regular_end_times,
     replay_answer,
     settled_time,
 )
+from drumflow.bench.answer_result import AnswerReplay, path_from
 from drumflow.errors import CaseError
 from drumflow.readers import read_text
 
@@ -358,10 +358,7 @@ def answer_ladder(spec: LadderSpec) -> AnswerLadder:
 def plot_ladder(ladder: AnswerLadder, path: Path) -> None:
     """Wall time against the largest answer error, one point per rung, the tolerance and the
     noise floor drawn: the Pareto picture of the ladder."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     fig, ax = plt.subplots(figsize=(8.0, 5.0))
     table = ladder.table

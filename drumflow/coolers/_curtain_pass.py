@@ -40,8 +40,8 @@ from numpy.typing import NDArray
 
 from drumflow.coolers._propagator import exposure_matrix
 from drumflow.coolers.curtain import element_exchange
-from drumflow.coolers.particle_interior import SphereConduction
 from drumflow.errors import DrumModelError
+from drumflow.physics.particle_interior import SphereConduction
 
 FloatArray = NDArray[np.float64]
 

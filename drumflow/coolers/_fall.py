@@ -1,7 +1,7 @@
 """A particle's fall from a flight through the drum's air: time, speed and mean film coefficient.
 
 The fall is vertical from rest, with gravity and the Schiller-Naumann drag of the vertical
-slip (the slice coupling's drag law, :func:`drumflow.coupling.physics.schiller_naumann_cd`);
+slip (the slice coupling's drag law, :func:`drumflow.physics.particle_air.schiller_naumann_cd`);
 the axial air does not change the vertical motion (it is a small share of the slip in a
 cooler: 3 m/s axial against several m/s of fall). The film coefficient along the fall is
 Ranz-Marshall on the full slip ``sqrt(v(t)^2 + U^2)`` with ``U`` the axial air speed, and the
@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from drumflow.coupling.physics import AirState, schiller_naumann_cd
+from drumflow.physics.particle_air import AirState, schiller_naumann_cd
 
 G = 9.81
 

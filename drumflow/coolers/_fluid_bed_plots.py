@@ -6,14 +6,14 @@ import csv
 from pathlib import Path
 from typing import Any
 
-import matplotlib
+import numpy as np
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
+from drumflow._mpl import pyplot
+from drumflow.coolers.fit import FitResult
+from drumflow.coolers.fluid_bed import Operation, UnitResult
+from drumflow.coolers.fluid_bed_case import KELVIN, MonthWeather
 
-from drumflow.coolers.fit import FitResult  # noqa: E402
-from drumflow.coolers.fluid_bed import KELVIN, MonthWeather, Operation, UnitResult  # noqa: E402
+plt = pyplot()
 
 
 def write_profile_csv(unit: UnitResult, path: Path) -> None:

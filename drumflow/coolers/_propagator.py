@@ -1,6 +1,6 @@
 """Exact linear maps of the shared particle-interior solver over a fixed exposure.
 
-A Crank-Nicolson step of :class:`~drumflow.coolers.particle_interior.SphereConduction` at a
+A Crank-Nicolson step of :class:`~drumflow.physics.particle_interior.SphereConduction` at a
 constant film coefficient ``h`` and gas temperature ``T_g`` is affine in the shell temperatures
 and in ``T_g``: ``T1 = S T0 + u T_g``. So ``advance`` over any number of equal steps is the
 ``k``-th power of that step, and a whole exposure (a fall through a curtain, a stay in the bed)
@@ -21,7 +21,7 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
-from drumflow.coolers.particle_interior import SphereConduction
+from drumflow.physics.particle_interior import SphereConduction
 
 FloatArray = NDArray[np.float64]
 

@@ -19,7 +19,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from drumflow.analysis.predict import PlantSpec
+from drumflow.coolers.plant import PlantSpec
 
 #: Perry's value of K (Friedman and Marshall 1949).
 HANDBOOK_COEFFICIENT = 0.23

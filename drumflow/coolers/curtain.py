@@ -11,9 +11,9 @@ Section 3). In each element:
 * the particles are exposed for their residence time ``dz / v_s`` (constant fall velocity
   ``v_s``, the paper's assumption) to gas at one temperature, with the film coefficient of
   Ranz and Marshall (paper Eq. 5, the same correlation as the slice coupling,
-  :func:`drumflow.coupling.physics.ranz_marshall_h`) at the superficial gas velocity;
+  :func:`drumflow.physics.particle_air.ranz_marshall_h`) at the superficial gas velocity;
 * the particle interior is the Crank-Nicolson shell model
-  :class:`~drumflow.coolers.particle_interior.SphereConduction` with a convective surface
+  :class:`~drumflow.physics.particle_interior.SphereConduction` with a convective surface
   (paper Eqs. 3-4);
 * the gas leaving the element follows from the energy balance (paper Eqs. 7-10), with the gas
   mass flow of the row ``rho_g v_g eps W dz`` (Eq. 9; the area normal to the gas is the row's
@@ -45,11 +45,11 @@ import numpy as np
 from numpy.typing import NDArray
 from pydantic import BaseModel, Field, model_validator
 
-from drumflow import air_properties
 from drumflow.case import INPUT_MODEL_CONFIG
 from drumflow.coolers._propagator import exposure_matrix
-from drumflow.coolers.particle_interior import Sphere, SphereConduction
-from drumflow.coupling.physics import AirState, ranz_marshall_h
+from drumflow.physics import air as air_properties
+from drumflow.physics.particle_air import AirState, ranz_marshall_h
+from drumflow.physics.particle_interior import Sphere, SphereConduction
 
 FloatArray = NDArray[np.float64]
 
@@ -199,7 +199,7 @@ class GasProperties:
         return self.heat_capacity * self.viscosity / self.conductivity
 
     def air_state(self) -> AirState:
-        """The coupling's :class:`~drumflow.coupling.physics.AirState` with these values."""
+        """The coupling's :class:`~drumflow.physics.particle_air.AirState` with these values."""
         return AirState(self.temperature_C, self.density, self.viscosity, self.conductivity,
                         self.prandtl)
 

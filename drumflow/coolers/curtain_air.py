@@ -20,17 +20,12 @@ from typing import Any
 from scipy.optimize import brentq
 
 from drumflow.analysis.closures import SliceClosures
-from drumflow.analysis.predict import PlantSpec
 from drumflow.coolers._fall import fall_kinematics
 from drumflow.coolers._transport import TransportLaw
-from drumflow.coolers.drum import (
-    MAX_CURTAIN_AIR_M3_S_M,
-    DrumOptions,
-    DrumResult,
-    PlantClosures,
-    solve_drum,
-)
-from drumflow.coupling.physics import AirState
+from drumflow.coolers.drum import MAX_CURTAIN_AIR_M3_S_M, DrumOptions, DrumResult, solve_drum
+from drumflow.coolers.drum_closures import PlantClosures
+from drumflow.coolers.plant import PlantSpec
+from drumflow.physics.particle_air import AirState
 
 __all__ = [
     "CURTAIN_AIR_SWEEP_M3_S_M",

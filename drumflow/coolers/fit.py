@@ -28,13 +28,8 @@ from scipy import stats
 from scipy.optimize import least_squares
 
 from drumflow.coolers import _fluidization as fl
-from drumflow.coolers.fluid_bed import (
-    KELVIN,
-    Conditions,
-    FluidBedCase,
-    operate,
-    run_unit,
-)
+from drumflow.coolers.fluid_bed import operate, run_unit
+from drumflow.coolers.fluid_bed_case import KELVIN, Conditions, FluidBedCase
 from drumflow.errors import BadFileError, CaseError
 from drumflow.readers import read_text
 

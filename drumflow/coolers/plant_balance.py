@@ -28,9 +28,9 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
-from drumflow import air_properties
-from drumflow.analysis.predict import PlantSpec
+from drumflow.coolers.plant import PlantSpec
 from drumflow.errors import DrumModelError
+from drumflow.physics import air as air_properties
 
 __all__ = [
     "BalanceOption",

@@ -1,7 +1,7 @@
 """Air acting on particles during the DEM run (one-way coupling).
 
 :mod:`~drumflow.coupling.spec` owns the coupling spec (built by the pipeline from the air
-stage's field, run by the DEM stage), :mod:`~drumflow.coupling.physics` the drag and heat laws,
+stage's field, run by the DEM stage), :mod:`~drumflow.physics.particle_air` the drag and heat laws,
 :mod:`~drumflow.coupling.library` LIGGGHTS' C library through ctypes,
 :mod:`~drumflow.coupling.driver` the loop that runs as a child process,
 :mod:`~drumflow.coupling.log` the reading of its logs.

@@ -60,9 +60,10 @@ from drumflow.coupling.interior import (
 )
 from drumflow.coupling.library import Liggghts
 from drumflow.coupling.mpi import allreduce_sum
-from drumflow.coupling.physics import AirState, convective_heat, drag_force, ranz_marshall_h
 from drumflow.coupling.spec import OVERLAP_OFF, OVERLAP_ON, STOP_REQUEST, STOPPED_RECORD
 from drumflow.coupling.stop import StopMonitor
+from drumflow.physics.drum_frame import drum_angle, rotate_to_drum_frame, rotate_to_lab_frame
+from drumflow.physics.particle_air import AirState, convective_heat, drag_force, ranz_marshall_h
 
 #: Per-atom properties the deck defines for the drag (``fix addforce`` reads them).
 DRAG_FIXES = ("air_fx", "air_fy", "air_fz")
@@ -103,9 +104,7 @@ def air_velocity_at(
     """
     if omega == 0.0 or isinstance(field, UniformAir):
         return field.sample(x)
-    from drumflow.air.field import rotate_to_drum_frame, rotate_to_lab_frame
-
-    angle = omega * time_s
+    angle = drum_angle(omega, time_s)
     return rotate_to_lab_frame(field.sample(rotate_to_drum_frame(x, angle)), angle)
 
 
@@ -216,9 +215,7 @@ class _AirWarming:
         ``conductance`` (W/K) and ``temperature`` (C) are each DEM sphere's film conductance to
         the air and the temperature behind it (the surface node)."""
         started = time.perf_counter()
-        from drumflow.air.field import rotate_to_drum_frame
-
-        points = rotate_to_drum_frame(x, self.omega * time_s) if self.omega else x
+        points = rotate_to_drum_frame(x, drum_angle(self.omega, time_s)) if self.omega else x
         self.cells = self.heat.cells_of(points)
         g = allreduce_sum(self.heat.deposit(self.cells, conductance))
         gt = allreduce_sum(self.heat.deposit(self.cells, conductance * temperature))

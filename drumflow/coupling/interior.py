@@ -8,7 +8,7 @@ air update the loop
 1. gives the outer shell whatever LIGGGHTS added to the particle's temperature since the last
    update beyond the air's heat (contact conduction enters through the surface),
 2. advances every profile over the coming interval with the Ranz-Marshall h of the particle's
-   slip and the air's temperature (:class:`~drumflow.coolers.particle_interior.ShellBatch`,
+   slip and the air's temperature (:class:`~drumflow.physics.particle_interior.ShellBatch`,
    Crank-Nicolson, the film acting on the surface temperature), and
 3. hands LIGGGHTS the heat that advance gave the air as a constant ``heatSource`` over the
    interval, so LIGGGHTS' ``Temp`` (the particle's enthalpy, its mean temperature) arrives
@@ -32,7 +32,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from drumflow.coolers.particle_interior import ShellBatch
+from drumflow.physics.particle_interior import ShellBatch
 
 #: The deck's per-atom vector of shell temperatures.
 SHELL_FIX = "shellT"

@@ -16,11 +16,11 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from drumflow.air.source import FieldSource, mean_axial_velocity
-from drumflow.air_properties import ideal_gas_density
-from drumflow.coolers.particle_interior import shells_for_biot
 from drumflow.coupling.interior import InteriorSpec
-from drumflow.coupling.physics import AirState, auto_coupling_interval, ranz_marshall_h
 from drumflow.geometry.fluid import fluid_mesh_size
+from drumflow.physics.air import ideal_gas_density
+from drumflow.physics.particle_air import AirState, auto_coupling_interval, ranz_marshall_h
+from drumflow.physics.particle_interior import shells_for_biot
 
 if TYPE_CHECKING:
     from drumflow.case import Case
@@ -177,7 +177,7 @@ def loop_heat_options(heat_capacity: float, thermo_every: int) -> dict[str, Any]
 
 def coupling_interval(case: Case, time_step: float, dump_every: int) -> int:
     """DEM steps between air updates: the case's, or 'auto' (see
-    :func:`~drumflow.coupling.physics.auto_coupling_interval`), at most one output interval."""
+    :func:`~drumflow.physics.particle_air.auto_coupling_interval`), at most one output interval."""
     if case.air.coupling_interval != "auto":
         return int(case.air.coupling_interval)
     state = AirState.at(case.air.inlet_temperature_C, case.air.pressure_kPa)

@@ -19,6 +19,7 @@ from drumflow.dem.restitution import calibrate_case
 from drumflow.dem.stability import CHECK_EVERY_STEPS
 from drumflow.dem.timestep import TimeStepChoice
 from drumflow.errors import GeometryError
+from drumflow.physics.drum_frame import drum_angle
 
 if TYPE_CHECKING:
     from drumflow.case import Case
@@ -194,7 +195,7 @@ def start_angle_deg(case: Case, plan: StepPlan, step: int) -> float:
     """The drum angle at ``step`` (omega t, counter-clockwise about +z), degrees in [0, 360): the
     turning mesh of a run from a start state is read in at it. The angle is that of the run's
     own clock (step times its time step), which the coupling loop samples the air at."""
-    return math.degrees(case.drum.omega * step * plan.time_step) % 360.0
+    return math.degrees(drum_angle(case.drum.omega, step * plan.time_step)) % 360.0
 
 
 def deck_context(

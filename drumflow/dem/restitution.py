@@ -15,7 +15,7 @@ Python (it reproduces the five numbers above to 4 digits), and :func:`calibrate_
 inverts it: the coefficient handed to LIGGGHTS is the one whose *realised* restitution at the
 run's time step equals the case's. The correction depends on the impact speed only through
 the number of steps per contact (t_c ~ v^(-1/5)); it is made at the scene's typical impact
-speed (:func:`drumflow.dem.timestep.typical_impact_velocity`), and ``drumflow verify`` checks
+speed (:func:`drumflow.dem.collision_speed.typical_impact_velocity`), and ``drumflow verify`` checks
 it against real LIGGGHTS collisions at other speeds.
 """
 
@@ -26,6 +26,8 @@ from dataclasses import asdict, dataclass
 from typing import TYPE_CHECKING, Any
 
 from scipy.optimize import brentq
+
+from drumflow.dem.collision_speed import typical_impact_velocity
 
 if TYPE_CHECKING:
     from drumflow.case import Case
@@ -189,10 +191,8 @@ def calibrate_case(case: Case, time_step: float,
     Keys ``particle_particle`` and ``particle_wall``. With ``run.restitution_correction``
     off, each coefficient is passed through unchanged (and the record shows what it realises).
     ``speed`` is the impact speed the calibration is exact at (m/s; default the scene's typical
-    speed, :func:`drumflow.dem.timestep.typical_impact_velocity`).
+    speed, :func:`drumflow.dem.collision_speed.typical_impact_velocity`).
     """
-    from drumflow.dem.timestep import typical_impact_velocity
-
     if speed is None:
         speed = typical_impact_velocity(case)
     out: dict[str, RestitutionCalibration] = {}

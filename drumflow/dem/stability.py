@@ -114,7 +114,7 @@ class StabilityLimits:
 
 def stability_limits(case: Case) -> StabilityLimits:
     """The scene's bounds, from its geometry, speed and material."""
-    from drumflow.dem.timestep import impact_velocity
+    from drumflow.dem.collision_speed import impact_velocity
 
     p = case.particles
     n = case.particle_count

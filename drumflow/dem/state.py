@@ -40,6 +40,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from drumflow.errors import BadFileError, RunDirectoryError, StartStateError
+from drumflow.physics.drum_frame import drum_angle
 
 if TYPE_CHECKING:
     from drumflow.case import Case
@@ -135,7 +136,7 @@ def state_from_snapshot(snap: Snapshot, case: Case, time_step: float, source: st
         radii=np.asarray(c["radius"], dtype=np.float64),
         temperatures_C=np.asarray(c["T"], dtype=np.float64),
         time_s=t,
-        drum_angle_rad=case.drum.omega * t,
+        drum_angle_rad=drum_angle(case.drum.omega, t),
         step=snap.step,
         time_step_s=time_step,
         case_hash=case.hash(),

@@ -12,11 +12,10 @@ import math
 from dataclasses import asdict, dataclass
 from typing import TYPE_CHECKING, Any
 
+from drumflow.dem.collision_speed import G, impact_velocity
+
 if TYPE_CHECKING:
     from drumflow.case import Case
-
-G = 9.81
-
 
 def rayleigh_time(radius: float, density: float, youngs_modulus: float, poisson: float) -> float:
     """Rayleigh time of a sphere, s.
@@ -40,21 +39,6 @@ def hertz_contact_time(
     e_eff = youngs_modulus / (2.0 * (1.0 - poisson**2))
     v = max(impact_velocity, 1e-6)
     return 2.87 * (m_eff**2 / (r_eff * e_eff**2 * v)) ** 0.2
-
-
-def impact_velocity(case: Case) -> float:
-    """A bound on collision speeds in the drum: free fall across the diameter, or the wall speed."""
-    return max(math.sqrt(2.0 * G * case.drum.diameter), case.drum.omega * case.drum.radius)
-
-
-def typical_impact_velocity(case: Case) -> float:
-    """A typical collision speed in the cascade, m/s: half of :func:`impact_velocity`.
-
-    Particles rarely fall the whole diameter before meeting another; the restitution
-    correction (:mod:`drumflow.dem.restitution`) is made at this speed, while the time step is
-    bounded at the full one (the shortest contacts).
-    """
-    return 0.5 * impact_velocity(case)
 
 
 #: Contacts per particle in the packed bed for :func:`spin_mode`: a dense random
@@ -166,7 +150,7 @@ def bed_spin_mode(case: Case, time_step: float) -> SpinMode:
     (:func:`bed_contact_overlap`), with the restitution coefficient a run at ``time_step``
     gives LIGGGHTS (:func:`drumflow.dem.restitution.calibrate_case`), with or without the
     tangential dashpot as the case has it (``contacts.tangential_damping``)."""
-    from drumflow.dem.restitution import calibrate_case  # it imports this module
+    from drumflow.dem.restitution import calibrate_case  # scipy: imported when needed
 
     p = case.particles
     coefficient = calibrate_case(case, time_step)["particle_particle"].liggghts_value

@@ -29,8 +29,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
+from drumflow.case.lifter_shape import all_plates
 from drumflow.errors import GeometryError
-from drumflow.geometry.lifters import all_plates
 
 if TYPE_CHECKING:
     from drumflow.case import Case
@@ -320,10 +320,9 @@ def plot_cross_section(
     case: Case, path: Path, particles_xy: NDArray[np.float64] | None = None
 ) -> None:
     """PNG of the drum cross-section with its lifters (and optionally particle positions)."""
-    import matplotlib
+    from drumflow._mpl import pyplot
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
     from matplotlib.patches import Circle, Polygon
 
     R = case.drum.radius

@@ -29,8 +29,8 @@ from __future__ import annotations
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from drumflow.air_properties import ideal_gas_density
 from drumflow.errors import GeometryError
+from drumflow.physics.air import ideal_gas_density
 
 if TYPE_CHECKING:
     from drumflow.case import Case

@@ -1,7 +1,7 @@
 """Figure 6 in motion: the drum's cross-section, coloured by temperature, snapshot by snapshot.
 
 :func:`render_animation` draws every full snapshot of a run (``dem/dumps/snap.*.txt or .npz``) the way
-:func:`drumflow.report.paper.render_snapshot_panels` draws four of them: the particles projected
+:func:`drumflow.report.snapshots.render_snapshot_panels` draws four of them: the particles projected
 on the section (x-y, seen along the drum axis), one colour scale for the whole run so that the
 cooling shows from frame to frame, the shell, and the lifters turned to the drum angle of the
 frame (``omega t``, as LIGGGHTS' ``move/mesh rotate`` turns them). Frames go to an animated GIF
@@ -27,7 +27,9 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from drumflow._mpl import pyplot
 from drumflow.errors import RunDirectoryError
+from drumflow.physics.drum_frame import drum_angle
 
 if TYPE_CHECKING:
     from drumflow.case import Case
@@ -125,23 +127,19 @@ def render_animation(run: RunDir, case: Case, target: Path | None = None, *,
     ValueError
         When ``max_frames`` < 1 or ``seconds_per_simulated_second`` <= 0.
     """
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
     from matplotlib.animation import FuncAnimation, PillowWriter
     from matplotlib.patches import Polygon
 
+    from drumflow.case.lifter_shape import all_plates
     from drumflow.dem.dumps import dump_files, read_dump
-    from drumflow.geometry.lifters import all_plates
-    from drumflow.report.paper import _time_step
 
     if max_frames < 1:
         raise ValueError(f"max_frames = {max_frames}: must be at least 1")
     files = dump_files(run.dem_dumps, "snap")
     if not files:
         raise RunDirectoryError(f"{run.dem_dumps}: no particle snapshot (snap.*.txt or .npz)")
-    dt = _time_step(run) or case.run.dump_interval
+    dt = run.recorded_time_step or case.run.dump_interval
     snaps = []
     skipped: list[str] = []
     for i in _pick(len(files), max_frames):
@@ -182,7 +180,7 @@ def render_animation(run: RunDir, case: Case, target: Path | None = None, *,
             patch.remove()
         plates.clear()
         if case.lifters.count > 0:
-            for plate in all_plates(r, case.lifters, case.drum.omega * times[k]):
+            for plate in all_plates(r, case.lifters, drum_angle(case.drum.omega, times[k])):
                 patch = Polygon(plate.corners(), closed=True, color="0.35", lw=0)
                 ax.add_patch(patch)
                 plates.append(patch)

@@ -20,8 +20,6 @@ without a case file and a manifest) is an error. Every path comes from
 
 from __future__ import annotations
 
-import base64
-import io
 import json
 import math
 import tempfile
@@ -35,13 +33,8 @@ import numpy as np
 import pandas as pd
 
 from drumflow.analysis.correlation import NusseltCorrelation
-from drumflow.analysis.methodology import (
-    FallingMassMode,
-    MethodologyResult,
-    NusseltConductivity,
-    analyse_run,
-    fit_runs,
-)
+from drumflow.analysis.methodology import analyse_run, fit_runs
+from drumflow.analysis.methodology_result import FallingMassMode, MethodologyResult, NusseltConductivity
 from drumflow.case import Case, load_case
 from drumflow.errors import (
     AnalysisInputError,
@@ -50,26 +43,21 @@ from drumflow.errors import (
     RenderError,
     RunDirectoryError,
 )
-from drumflow.readers import read_json_object
+from drumflow.readers import read_json_object_if_present
+from drumflow.report.page_parts import (
+    Figure,
+    Table,
+    figure_uri,
+    file_uri,
+    fmt,
+    h_figure,
+    nusselt_reynolds_figure,
+    render_page,
+    table8,
+)
 from drumflow.rundir import RunDir
 
 __all__ = ["write_report"]
-
-
-@dataclass
-class _Table:
-    caption: str
-    header: list[str]
-    rows: list[list[str]]
-    note: str = ""
-
-
-@dataclass
-class _Figure:
-    title: str
-    caption: str = ""
-    uri: str | None = None
-    note: str | None = None
 
 
 @dataclass
@@ -78,77 +66,9 @@ class _RunView:
     path: str
     anchor: str
     notes: list[str] = field(default_factory=list)
-    tables: list[_Table] = field(default_factory=list)
-    figures: list[_Figure] = field(default_factory=list)
+    tables: list[Table] = field(default_factory=list)
+    figures: list[Figure] = field(default_factory=list)
     manifest_json: str | None = None
-
-
-# ------------------------------------------------------------------------------ helpers
-
-
-def _fmt(value: Any, digits: int = 5) -> str:
-    if value is None:
-        return "–"
-    if isinstance(value, (bool, np.bool_)):
-        return "yes" if value else "no"
-    if isinstance(value, (int, np.integer)):
-        return f"{int(value):,}"
-    if isinstance(value, (float, np.floating)):
-        v = float(value)
-        if not math.isfinite(v):
-            return "–"
-        return f"{v:.{digits}g}"
-    if isinstance(value, (list, tuple)):
-        return ", ".join(_fmt(v, digits) for v in value)
-    return str(value)
-
-
-def _png_uri(data: bytes) -> str:
-    return "data:image/png;base64," + base64.b64encode(data).decode("ascii")
-
-
-def _file_uri(path: Path) -> str | None:
-    try:
-        data = path.read_bytes()
-    except OSError:
-        return None
-    # Only PNG pictures and GIF animations are embedded, each under its own type.
-    if data.startswith(b"\x89PNG\r\n\x1a\n"):
-        return _png_uri(data)
-    if data.startswith((b"GIF87a", b"GIF89a")):
-        return "data:image/gif;base64," + base64.b64encode(data).decode("ascii")
-    return None
-
-
-def _plt():  # type: ignore[no-untyped-def]
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
-
-
-def _fig_uri(draw: Callable[[Any], None], size: tuple[float, float] = (6.4, 3.8)) -> str:
-    plt = _plt()
-    fig, ax = plt.subplots(figsize=size, dpi=110)
-    try:
-        draw(ax)
-        fig.tight_layout()
-        buf = io.BytesIO()
-        # No "Software" text chunk: the page should carry no outside references, even encoded.
-        fig.savefig(buf, format="png", metadata={"Software": None})
-    finally:
-        plt.close(fig)
-    return _png_uri(buf.getvalue())
-
-
-def _read_json(path: Path) -> dict[str, Any] | None:
-    """A run's JSON object, or None when the file is missing; a damaged one (cut short, not
-    UTF-8, not an object) is refused by name rather than left out of the page."""
-    if not path.exists():
-        return None
-    return read_json_object(path)
 
 
 def _anchor(i: int, name: str) -> str:
@@ -159,22 +79,22 @@ def _anchor(i: int, name: str) -> str:
 # ---------------------------------------------------------------------------- run parts
 
 
-def _case_table(case: Case) -> _Table:
+def _case_table(case: Case) -> Table:
     rows: list[list[str]] = []
     for section, values in case.model_dump(mode="json").items():
         if isinstance(values, dict):
             for key, val in values.items():
                 if isinstance(val, dict):
                     for sub, v in val.items():
-                        rows.append([f"{section}.{key}.{sub}", _fmt(v)])
+                        rows.append([f"{section}.{key}.{sub}", fmt(v)])
                 else:
-                    rows.append([f"{section}.{key}", _fmt(val)])
+                    rows.append([f"{section}.{key}", fmt(val)])
         else:
-            rows.append([section, _fmt(values)])
-    rows.append(["(derived) particle count", _fmt(case.particle_count)])
-    rows.append(["(derived) particle mass total, kg", _fmt(case.particle_mass_total)])
-    rows.append(["(derived) Froude number", _fmt(case.drum.froude)])
-    return _Table("Case", ["field", "value"], rows)
+            rows.append([section, fmt(values)])
+    rows.append(["(derived) particle count", fmt(case.particle_count)])
+    rows.append(["(derived) particle mass total, kg", fmt(case.particle_mass_total)])
+    rows.append(["(derived) Froude number", fmt(case.drum.froude)])
+    return Table("Case", ["field", "value"], rows)
 
 
 _SUMMARY_LABELS = {
@@ -192,18 +112,18 @@ _SUMMARY_LABELS = {
 }
 
 
-def _summary_table(summary: dict[str, Any]) -> _Table:
-    rows = [[label, _fmt(summary[key])] for key, label in _SUMMARY_LABELS.items() if key in summary]
+def _summary_table(summary: dict[str, Any]) -> Table:
+    rows = [[label, fmt(summary[key])] for key, label in _SUMMARY_LABELS.items() if key in summary]
     # Any other scalar the run recorded, so nothing in summary.json is hidden.
     for key, val in summary.items():
         if key not in _SUMMARY_LABELS and isinstance(val, (int, float, str, bool)):
-            rows.append([key, _fmt(val)])
-    return _Table("Observables (summary.json)", ["quantity", "value"], rows)
+            rows.append([key, fmt(val)])
+    return Table("Observables (summary.json)", ["quantity", "value"], rows)
 
 
-def _mean_temperature_figure(run: RunDir) -> _Figure:
-    fig = _Figure("Mean particle temperature (Figures 7 and 8)")
-    png = _file_uri(run.mean_temperature_plot)
+def _mean_temperature_figure(run: RunDir) -> Figure:
+    fig = Figure("Mean particle temperature (Figures 7 and 8)")
+    png = file_uri(run.mean_temperature_plot)
     if png is not None:
         fig.uri = png
         return fig
@@ -222,42 +142,14 @@ def _mean_temperature_figure(run: RunDir) -> _Figure:
         ax.set_ylabel("mean particle temperature (°C)")
         ax.grid(alpha=0.3)
 
-    fig.uri = _fig_uri(draw)
+    fig.uri = figure_uri(draw)
     fig.caption = (f"from {csv.relative_to(run.root)} (no {run.mean_temperature_plot.name} "
                    "in the run)")
     return fig
 
 
-def _h_figure(result: MethodologyResult) -> _Figure:
-    s = result.steps
-
-    def draw(ax: Any) -> None:
-        ok = s["valid"].to_numpy(dtype=bool)
-        ax.plot(s["time_s"][ok], s["h_W_m2K"][ok], ".", ms=3, color="tab:blue", label="per step")
-        ax.axhline(result.h_mean_w_m2k, color="tab:red", lw=1.4,
-                   label=f"time average {result.h_mean_w_m2k:.4g} W/(m² K)")
-        ax.set_xlabel("time (s)")
-        ax.set_ylabel("h (W/(m² K))")
-        # Plain tick labels: an offset such as "1e-5+6e1" hides the value being read off.
-        ax.ticklabel_format(axis="y", useOffset=False, style="plain")
-        h_ok = s["h_W_m2K"].to_numpy(dtype=float)[ok]
-        if h_ok.size and np.ptp(h_ok) < 0.01 * abs(result.h_mean_w_m2k):
-            # A nearly constant h would be drawn as noise magnified to the full axis height.
-            pad = 0.05 * abs(result.h_mean_w_m2k)
-            ax.set_ylim(result.h_mean_w_m2k - pad, result.h_mean_w_m2k + pad)
-        ax.legend(fontsize=8)
-        ax.grid(alpha=0.3)
-
-    masked = result.masked
-    caption = f"{result.n_valid} valid of {result.n_steps} steps"
-    if masked:
-        caption += "; masked: " + ", ".join(f"{v} {k.replace('_', ' ')}" for k, v in masked.items())
-    return _Figure("Heat-transfer coefficient per step (Eqs. 34-41)", caption, _fig_uri(draw))
-
-
-def _particles_figure(run: RunDir, case: Case, manifest: dict[str, Any] | None,
-                      render_3d: bool, timeout_s: float) -> _Figure:
-    fig = _Figure("Particles coloured by temperature, last snapshot (Figure 6)")
+def _particles_figure(run: RunDir, case: Case, render_3d: bool, timeout_s: float) -> Figure:
+    fig = Figure("Particles coloured by temperature, last snapshot (Figure 6)")
     if not render_3d:
         fig.note = "3-D rendering was switched off for this report"
         return fig
@@ -274,8 +166,8 @@ def _particles_figure(run: RunDir, case: Case, manifest: dict[str, Any] | None,
         missing = [c for c in ("x", "y", "z", "T") if c not in cols]
         if missing:
             raise RenderError(f"{files[-1]} lacks column(s) {', '.join(missing)}")
-        ts = ((manifest or {}).get("time_step") or {}).get("time_step")
-        when = f"t = {snap.step * float(ts):.3g} s" if ts else f"step {snap.step}"
+        ts = run.recorded_time_step
+        when = f"t = {snap.step * ts:.3g} s" if ts else f"step {snap.step}"
         with tempfile.TemporaryDirectory(prefix="drumflow-report-") as tmp:
             png = render_particles_isolated(
                 cols["x"], cols["y"], cols["z"], cols["T"], Path(tmp) / "particles.png",
@@ -284,7 +176,7 @@ def _particles_figure(run: RunDir, case: Case, manifest: dict[str, Any] | None,
                 title=f"{case.name}, {when}",
                 timeout_s=timeout_s,
             )
-            fig.uri = _file_uri(png)
+            fig.uri = file_uri(png)
         fig.caption = f"{len(snap):,} particles from {files[-1].name}, {when} (PyVista, off-screen)"
         if fig.uri is None:
             fig.note = "the renderer wrote no PNG picture"
@@ -310,37 +202,37 @@ def _run_view(i: int, run: RunDir, result: MethodologyResult | None, why_not: st
         view.notes.extend(result.warnings)
     if case is not None:
         view.tables.append(_case_table(case))
-    summary = _read_json(run.summary_path)
+    summary = read_json_object_if_present(run.summary_path)
     if summary is not None:
         view.tables.append(_summary_table(summary))
     else:
         view.notes.append(f"no summary: {run.summary_path} is missing")
-    manifest = _read_json(run.manifest_path)
+    manifest = read_json_object_if_present(run.manifest_path)
     view.manifest_json = json.dumps(manifest, indent=2, sort_keys=False) if manifest else None
 
     view.figures.append(_mean_temperature_figure(run))
     if result is not None:
-        view.figures.append(_h_figure(result))
-    crossings = _Figure("Particles crossing the axis plane downwards (Figure 4)",
-                        uri=_file_uri(run.crossings_plot))
+        view.figures.append(h_figure(result))
+    crossings = Figure("Particles crossing the axis plane downwards (Figure 4)",
+                        uri=file_uri(run.crossings_plot))
     if crossings.uri is None:
         crossings.note = f"no crossing plot: {run.crossings_plot} is missing"
     view.figures.append(crossings)
     if case is not None:
-        view.figures.append(_particles_figure(run, case, manifest, render_3d, timeout_s))
-    section = _file_uri(run.particles_plot)
+        view.figures.append(_particles_figure(run, case, render_3d, timeout_s))
+    section = file_uri(run.particles_plot)
     if section is not None:
-        view.figures.append(_Figure("Cross-section at the end of the run", uri=section))
-    geometry = _file_uri(run.geometry_picture)
+        view.figures.append(Figure("Cross-section at the end of the run", uri=section))
+    geometry = file_uri(run.geometry_picture)
     if geometry is not None:
-        view.figures.append(_Figure("Drum and lifter geometry", uri=geometry))
+        view.figures.append(Figure("Drum and lifter geometry", uri=geometry))
     return view
 
 
 # --------------------------------------------------------------------------- sweep parts
 
 
-def _table6(names: list[str], results: list[MethodologyResult | None]) -> _Table:
+def _table6(names: list[str], results: list[MethodologyResult | None]) -> Table:
     rows_def: list[tuple[str, Callable[[MethodologyResult], Any]]] = [
         ("Particle diameter Dp (mm)", lambda r: r.case.particles.diameter * 1e3),
         ("Time step dt (s)", lambda r: r.dt_s),
@@ -351,12 +243,12 @@ def _table6(names: list[str], results: list[MethodologyResult | None]) -> _Table
         ("Average heat transfer coefficient h (W/(m² K))", lambda r: r.h_mean_w_m2k),
         ("Valid steps / steps", lambda r: f"{r.n_valid:,} / {r.n_steps:,}"),
     ]
-    rows = [[label] + [_fmt(get(r)) if r is not None else "–" for r in results]
+    rows = [[label] + [fmt(get(r)) if r is not None else "–" for r in results]
             for label, get in rows_def]
-    return _Table("Table 6. Heat transfer variables during one time step", ["Model"] + names, rows)
+    return Table("Table 6. Heat transfer variables during one time step", ["Model"] + names, rows)
 
 
-def _table7(names: list[str], results: list[MethodologyResult | None]) -> _Table:
+def _table7(names: list[str], results: list[MethodologyResult | None]) -> Table:
     columns: list[tuple[str, Any, Any]] = []  # (header, exchanger result, methodology result)
     for name, r in zip(names, results, strict=True):
         if r is None:
@@ -378,108 +270,29 @@ def _table7(names: list[str], results: list[MethodologyResult | None]) -> _Table
         ("Exchanged heat Q_he (kW)", lambda c: c[1].heat_exchanged_w / 1e3),
         ("Total area of heat exchange A_he (m²)", lambda c: c[1].area_m2),
     ]
-    rows = [[label] + [_fmt(get(c)) for c in columns] for label, get in spec]
+    rows = [[label] + [fmt(get(c)) for c in columns] for label, get in spec]
     note = (
         "Model columns: A_he from the simulated section (Eq. 46 with L/l), T_mo solved from "
         "Q_he = Q_m (Eq. 48). Plant columns (when the case gives plant.material_outlet_temperature_C): "
         "the area the plant needs to reach that outlet temperature with the run's h."
     )
-    return _Table("Table 7. Thermodynamic and counter-current exchanger models",
+    return Table("Table 7. Thermodynamic and counter-current exchanger models",
                   ["Property"] + [c[0] for c in columns], rows, note)
 
 
-def _table8(corr: NusseltCorrelation) -> list[_Table]:
-    coef = _Table(
-        "Table 8a. Correlation Nu = a Re^b Pr^c (Eq. 56, Levenberg-Marquardt)",
-        ["Parameter", "Estimate", "Std. error", "95 % confidence interval"],
-        [
-            ["a", _fmt(corr.a, 6), _fmt(corr.se_a, 3), _fmt(corr.ci_a, 5)],
-            ["b", _fmt(corr.b, 6), _fmt(corr.se_b, 3), _fmt(corr.ci_b, 5)],
-            ["c" + ("" if corr.prandtl_exponent_fitted else " (fixed)"), _fmt(corr.c, 6),
-             _fmt(corr.se_c, 3), _fmt(corr.ci_c, 5)],
-        ],
-        note=corr.note,
-    )
-    t = corr.anova
-    anova = _Table(
-        "Table 8. Analysis of variance of the non-linear correlation",
-        ["Source of variance", "Sum of squares", "Degrees of freedom", "Mean square",
-         "F observed", "P-value"],
-        [
-            ["Model", _fmt(t.ss_model, 6), _fmt(t.df_model), _fmt(t.ms_model, 6),
-             _fmt(t.f_value, 6), f"{t.p_value:.4f}"],
-            ["Error", _fmt(t.ss_error, 6), _fmt(t.df_error), _fmt(t.ms_error, 6), "", ""],
-            ["Total", _fmt(t.ss_total, 6), _fmt(t.df_total), "", "", ""],
-            ["Adjusted R-squared (%)", _fmt(100 * corr.adjusted_r_squared, 6), "", "", "", ""],
-        ],
-        note=(
-            f"{corr.n:,} steps used, {corr.n_dropped:,} dropped (masked or non-positive); valid "
-            f"for {corr.reynolds_range[0]:.5g} < Re < {corr.reynolds_range[1]:.5g}. Uncorrected "
-            "sums of squares as in Statgraphics; R-squared against the corrected total."
-        ),
-    )
-    serial = corr.serial
-    if serial is None:
-        return [coef, anova]
-    honest = _Table(
-        "Table 8b. The same fit with serially correlated time steps",
-        ["Parameter", "Estimate", "Std. error (independent steps)",
-         "Std. error (serial correlation)", "95 % confidence interval"],
-        [
-            [name, _fmt(value, 6), _fmt(naive, 3), _fmt(wide, 3), _fmt(ci, 5)]
-            for name, value, naive, wide, ci in (
-                ("a", corr.a, corr.se_a, serial.se_a, serial.ci_a),
-                ("b", corr.b, corr.se_b, serial.se_b, serial.ci_b),
-                ("c" + ("" if corr.prandtl_exponent_fitted else " (fixed)"), corr.c, corr.se_c,
-                 serial.se_c, serial.ci_c),
-            )
-        ],
-        note=(
-            f"Consecutive steps are not independent: lag-1 autocorrelation of the residuals "
-            f"{serial.lag1:.3f} (within each run), so the {corr.n:,} steps carry the information "
-            f"of about {serial.n_effective:.4g} independent ones (n (1 - rho) / (1 + rho)); the "
-            f"errors are {serial.inflation:.3g} times the table's, and the interval uses "
-            f"{serial.df_effective:.4g} degrees of freedom."
-        ),
-    )
-    return [coef, anova, honest]
 
 
 def _figure9(names: list[str], results: list[MethodologyResult | None],
-             corr: NusseltCorrelation | None) -> _Figure:
-    fig = _Figure("Nusselt against Reynolds (Figure 9)")
+             corr: NusseltCorrelation | None) -> Figure:
     pairs = [(n, r) for n, r in zip(names, results, strict=True) if r is not None]
     if not pairs:
-        fig.note = "no run could be analysed, so there are no Nusselt and Reynolds numbers"
-        return fig
+        return Figure("Nusselt against Reynolds (Figure 9)", note="no run could be analysed, so "
+                      "there are no Nusselt and Reynolds numbers")
     pr_all = np.concatenate([r.prandtl[np.isfinite(r.prandtl)] for _, r in pairs])
     pr_mean = float(pr_all.mean()) if pr_all.size else math.nan
-
-    def draw(ax: Any) -> None:
-        re_all = []
-        for n, r in pairs:
-            ok = np.isfinite(r.nusselt) & (r.nusselt > 0)
-            ax.plot(r.reynolds[ok], r.nusselt[ok], ".", ms=3, alpha=0.6, label=n)
-            re_all.append(r.reynolds[ok])
-        re_cat = np.concatenate(re_all) if re_all else np.array([])
-        if corr is not None and re_cat.size:
-            grid = np.linspace(re_cat.min(), re_cat.max(), 200)
-            ax.plot(grid, corr.a * grid**corr.b * pr_mean**corr.c, color="black", lw=1.4,
-                    label=f"Nu = {corr.a:.4g} Re^{corr.b:.4g} Pr^{corr.c:.4g}")
-        if re_cat.size and re_cat.max() > 10 * re_cat.min() > 0:
-            ax.set_xscale("log")
-            ax.set_yscale("log")
-        else:
-            # Plain tick labels: one run spans a tiny Re range, and an offset label such as
-            # "+9.27e4" hides the values.
-            ax.ticklabel_format(useOffset=False, style="plain")
-        ax.set_xlabel("Re (Eq. 51)")
-        ax.set_ylabel("Nu (Eq. 49)")
-        ax.set_title(f"Pr = {pr_mean:.4g}", fontsize=9)
-        ax.legend(fontsize=8)
-        ax.grid(alpha=0.3)
-
-    fig.uri = _fig_uri(draw)
+    fig = nusselt_reynolds_figure("Nusselt against Reynolds (Figure 9)", pairs, corr, pr_mean,
+                                  xlabel="Re (Eq. 51)", ylabel="Nu (Eq. 49)",
+                                  axes_title=f"Pr = {pr_mean:.4g}")
     k = {r.nusselt_conductivity for _, r in pairs}
     fig.caption = (
         "per-step values of the valid steps; Nu with the "
@@ -490,7 +303,7 @@ def _figure9(names: list[str], results: list[MethodologyResult | None],
 
 
 def _comparison(names: list[str], results: list[MethodologyResult | None],
-                why_not: list[str | None]) -> _Table:
+                why_not: list[str | None]) -> Table:
     rows = []
     for name, r, why in zip(names, results, why_not, strict=True):
         if r is None:
@@ -499,16 +312,16 @@ def _comparison(names: list[str], results: list[MethodologyResult | None],
             continue
         rows.append([
             name,
-            _fmt(r.case.particles.diameter * 1e3),
-            _fmt(r.case.drum.rpm),
-            _fmt(r.case.air.mass_flow),
-            _fmt(r.h_mean_w_m2k),
-            _fmt(float(np.nanmean(r.reynolds))),
-            _fmt(float(np.nanmean(r.nusselt))),
-            _fmt(r.exchanger.material_outlet_temperature_c),
+            fmt(r.case.particles.diameter * 1e3),
+            fmt(r.case.drum.rpm),
+            fmt(r.case.air.mass_flow),
+            fmt(r.h_mean_w_m2k),
+            fmt(float(np.nanmean(r.reynolds))),
+            fmt(float(np.nanmean(r.nusselt))),
+            fmt(r.exchanger.material_outlet_temperature_c),
             "; ".join(r.warnings),
         ])
-    return _Table(
+    return Table(
         "Runs",
         ["run", "Dp (mm)", "rpm", "air (kg/s)", "h (W/(m² K))", "mean Re", "mean Nu",
          "T_mo (°C)", "note"],
@@ -565,8 +378,6 @@ def write_report(
         If a file of a run is damaged (cut short, not UTF-8, a series that ends before the
         run): refused, not turned into a note.
     """
-    from jinja2 import Environment, PackageLoader, StrictUndefined
-
     import drumflow
 
     if not run_dirs:
@@ -633,9 +444,8 @@ def write_report(
         f"drumflow report: {names[0]}" if len(names) == 1
         else f"drumflow report: sweep of {len(names)} runs"
     )
-    env = Environment(loader=PackageLoader("drumflow.report", "templates"), autoescape=True,
-                      undefined=StrictUndefined, trim_blocks=True, lstrip_blocks=True)
-    html = env.get_template(TEMPLATE).render(
+    html = render_page(
+        TEMPLATE,
         title=title,
         version=drumflow.__version__,
         generated=time.strftime("%Y-%m-%d %H:%M:%S %z"),
@@ -646,7 +456,7 @@ def write_report(
         comparison=_comparison(names, results, why_not) if len(roots) > 1 else None,
         table6=_table6(names, results),
         table7=_table7(names, results),
-        table8=_table8(corr) if corr is not None else None,
+        table8=table8(corr) if corr is not None else None,
         equation=(
             f"Nu = {corr.a:.6g} Re^{corr.b:.6g} Pr^{corr.c:.6g}, "
             f"{corr.reynolds_range[0]:.5g} < Re < {corr.reynolds_range[1]:.5g}"

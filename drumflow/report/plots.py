@@ -9,23 +9,17 @@ import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
+from drumflow._mpl import pyplot
+from drumflow.physics.drum_frame import drum_angle
+
 if TYPE_CHECKING:
     from drumflow.analysis.observables import FallingMassFlow
     from drumflow.case import Case
 
 
-def _plt():  # type: ignore[no-untyped-def]
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
-
-
 def plot_mean_temperature(times: NDArray, T_mean: NDArray, path: Path, title: str) -> None:
     """Mean particle temperature against time (the paper's Figures 7 and 8)."""
-    plt = _plt()
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(6, 3.6), dpi=120)
     ax.plot(times, T_mean, color="tab:red", lw=1.6)
     ax.set_xlabel("time (s)")
@@ -50,7 +44,7 @@ def plot_crossings(
     title: str,
 ) -> None:
     """Crossing time against axial position (the paper's Figure 4), and the cumulative count."""
-    plt = _plt()
+    plt = pyplot()
     fig, (ax, ax2) = plt.subplots(1, 2, figsize=(9, 3.6), dpi=120, gridspec_kw={"width_ratios": [3, 2]})
     inwin = crossings["time"] >= flow.window_start_s
     ax.scatter(crossings["time"][~inwin], crossings["z"][~inwin], s=6, color="0.7", lw=0,
@@ -80,16 +74,16 @@ MAX_DRAWN_PARTICLES = 100_000
 def plot_particles(x: NDArray, y: NDArray, T: NDArray, case: Case, path: Path, title: str,
                    time_s: float | None = None) -> None:
     """Cross-section view of the particles coloured by temperature, lifters where they are."""
-    plt = _plt()
+    plt = pyplot()
     from matplotlib.patches import Circle, Polygon
 
-    from drumflow.geometry.lifters import all_plates
+    from drumflow.case.lifter_shape import all_plates
 
     radius = case.drum.radius
     fig, ax = plt.subplots(figsize=(5.2, 4.6), dpi=120)
     ax.add_patch(Circle((0, 0), radius, fill=False, lw=1.5, color="0.3"))
     if time_s is not None:
-        for plate in all_plates(radius, case.lifters, offset=case.drum.omega * time_s):
+        for plate in all_plates(radius, case.lifters, offset=drum_angle(case.drum.omega, time_s)):
             c = plate.corners()
             r = np.hypot(c[:, 0], c[:, 1])
             ax.add_patch(Polygon(c * np.minimum(1.0, radius / r)[:, None], color="0.45"))
@@ -112,7 +106,7 @@ def plot_particles(x: NDArray, y: NDArray, T: NDArray, case: Case, path: Path, t
 
 def plot_air_heat(coupling: pd.DataFrame, path: Path, title: str) -> None:
     """Heat removed by the air: rate (W) and cumulative (J) against time."""
-    plt = _plt()
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(6, 3.6), dpi=120)
     t = coupling["time_s"].to_numpy()
     ax.plot(t, -coupling["heat_to_particles_W"].to_numpy(), color="tab:blue", lw=1.2)

@@ -16,24 +16,23 @@ Written into ``OUT`` (default ``RUN_DIR/vtk``):
   drum's rotating frame: the file holds it at t = 0, when drum and lab frame coincide (rotate it
   by ``omega t`` about z, ParaView's Transform filter, to lay it over a later snapshot).
 
-Library code: writes files and returns what it wrote; ``drumflow.cli_export`` prints.
+Library code: writes files and returns what it wrote; ``drumflow.cli.export`` prints.
 """
 
 from __future__ import annotations
 
-import math
 from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 from xml.sax.saxutils import quoteattr
 
 import numpy as np
-from numpy.typing import NDArray
 
 from drumflow.case import load_case
 from drumflow.coupling.spec import COUPLING_FILE
 from drumflow.dem.dumps import dump_files, read_dump
 from drumflow.errors import BadFileError, RunDirectoryError
+from drumflow.physics.drum_frame import drum_angle, rotate_about_axis
 from drumflow.readers import read_json_object
 from drumflow.rundir import RunDir
 
@@ -42,7 +41,7 @@ if TYPE_CHECKING:
 
     from drumflow.case import Case
 
-__all__ = ["VtkExport", "drum_angle", "export_vtk", "rotate_about_axis"]
+__all__ = ["VtkExport", "export_vtk"]
 
 
 @dataclass(frozen=True)
@@ -60,18 +59,6 @@ class VtkExport:
 
     def as_dict(self) -> dict[str, Any]:
         return asdict(self)
-
-
-def drum_angle(case: Case, time_s: float) -> float:
-    """The drum's rotation angle at ``time_s``, rad: ``omega t`` (counter-clockwise about +z)."""
-    return case.drum.omega * time_s
-
-
-def rotate_about_axis(points: NDArray[np.float64], angle: float) -> NDArray[np.float64]:
-    """Points (n, 3) turned by ``angle`` (rad) counter-clockwise about the z axis."""
-    c, s = math.cos(angle), math.sin(angle)
-    p = np.asarray(points, dtype=float)
-    return np.column_stack([c * p[:, 0] - s * p[:, 1], s * p[:, 0] + c * p[:, 1], p[:, 2]])
 
 
 def _write_pvd(path: Path, entries: list[tuple[float, str]], every_time: str | None = None) -> None:
@@ -212,8 +199,8 @@ def export_vtk(run_dir: Path | str, out: Path | str | None = None) -> VtkExport:
         particle_entries.append((t, name))
         counts.append(len(snap))
         turned = moving.copy()
-        turned.points = rotate_about_axis(np.asarray(moving.points), drum_angle(case, t))
-        turned.field_data["drum_angle_rad"] = np.array([drum_angle(case, t)])
+        turned.points = rotate_about_axis(np.asarray(moving.points), drum_angle(case.drum.omega, t))
+        turned.field_data["drum_angle_rad"] = np.array([drum_angle(case.drum.omega, t)])
         wname = f"walls/moving_{snap.step:010d}.vtp"
         turned.save(str(target / wname), binary=True)
         wall_entries.append((t, wname))

@@ -34,10 +34,11 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from drumflow.analysis._validate import AnalysisInputError
 from drumflow.analysis.correlation import NusseltCorrelation, fit_nusselt_correlation
-from drumflow.analysis.methodology import MethodologyResult, analyse_run, fit_runs
+from drumflow.analysis.methodology import analyse_run, fit_runs
+from drumflow.analysis.methodology_result import MethodologyResult
 from drumflow.errors import DrumflowError
+from drumflow.physics.validation import AnalysisInputError
 from drumflow.sweep.driver import SweepDir, statuses
 from drumflow.sweep.spec import Member, format_value, short_axis
 
@@ -149,7 +150,7 @@ def analyse_sweep(sd: SweepDir) -> SweepAnalysis:
 
 def _member_table(sd: SweepDir, ok: list[MemberAnalysis],
                   fit: NusseltCorrelation | None) -> pd.DataFrame:
-    from drumflow.analysis.predict import predict_plant
+    from drumflow.coolers.prediction import predict_plant
 
     rows = []
     for m in ok:
@@ -197,7 +198,7 @@ def _numeric(values: list[Any]) -> bool:
 
 def _effect_figure(analysis: SweepAnalysis, axis: str) -> str:
     """h, falling mass flow and plant T_mo against one axis, a line per setting of the others."""
-    from drumflow.report.html import _fig_uri
+    from drumflow.report.page_parts import figure_uri
 
     table = analysis.table
     others = [a for a in analysis.sd.sweep.axes if a != axis and a in table.columns]
@@ -231,11 +232,11 @@ def _effect_figure(analysis: SweepAnalysis, axis: str) -> str:
                 ax.set_xticks(range(len(cats)), cats, rotation=20, fontsize=7)
         axes[0].legend(fontsize=7)
 
-    return _fig_uri(draw, size=(11.0, 3.4))
+    return figure_uri(draw, size=(11.0, 3.4))
 
 
 def _fit_figure(analysis: SweepAnalysis) -> str:
-    from drumflow.report.html import _fig_uri
+    from drumflow.report.page_parts import figure_uri
 
     ok = [m for m in analysis.analysed if m.result is not None]
     pr_mean = float(np.nanmean(analysis.table["prandtl_mean"])) if len(analysis.table) else math.nan
@@ -267,11 +268,11 @@ def _fit_figure(analysis: SweepAnalysis) -> str:
         ax.legend(fontsize=7)
         ax.grid(alpha=0.3)
 
-    return _fig_uri(draw, size=(7.0, 4.2))
+    return figure_uri(draw, size=(7.0, 4.2))
 
 
 def _residual_figure(analysis: SweepAnalysis) -> str:
-    from drumflow.report.html import _fig_uri
+    from drumflow.report.page_parts import figure_uri
 
     t = analysis.table
 
@@ -282,16 +283,16 @@ def _residual_figure(analysis: SweepAnalysis) -> str:
         ax.set_title("member fit: residual of each member's mean Nu", fontsize=9)
         ax.grid(alpha=0.3, axis="y")
 
-    return _fig_uri(draw, size=(6.0, 3.2))
+    return figure_uri(draw, size=(6.0, 3.2))
 
 
 def _fit_rows(fit: NusseltCorrelation) -> list[list[str]]:
-    from drumflow.report.html import _fmt
+    from drumflow.report.page_parts import fmt
 
-    rows = [["a", _fmt(fit.a, 5), _fmt(fit.se_a, 3), _fmt(fit.ci_a, 4)],
-            ["b", _fmt(fit.b, 5), _fmt(fit.se_b, 3), _fmt(fit.ci_b, 4)]]
-    rows.append(["c" + ("" if fit.prandtl_exponent_fitted else " (held)"), _fmt(fit.c, 5),
-                 _fmt(fit.se_c, 3), _fmt(fit.ci_c, 4)])
+    rows = [["a", fmt(fit.a, 5), fmt(fit.se_a, 3), fmt(fit.ci_a, 4)],
+            ["b", fmt(fit.b, 5), fmt(fit.se_b, 3), fmt(fit.ci_b, 4)]]
+    rows.append(["c" + ("" if fit.prandtl_exponent_fitted else " (held)"), fmt(fit.c, 5),
+                 fmt(fit.se_c, 3), fmt(fit.ci_c, 4)])
     return rows
 
 
@@ -358,7 +359,7 @@ def write_sweep_report(analysis: SweepAnalysis, out_dir: Path | None = None) -> 
     from jinja2 import Environment, StrictUndefined
 
     import drumflow
-    from drumflow.report.html import _fmt
+    from drumflow.report.page_parts import fmt
 
     sd = analysis.sd
     out = (out_dir or sd.root / "analysis").resolve()
@@ -377,7 +378,7 @@ def write_sweep_report(analysis: SweepAnalysis, out_dir: Path | None = None) -> 
 
     t = analysis.table
     header = list(t.columns)
-    rows = [[_fmt(v, 5) for v in row] for row in t.itertuples(index=False)]
+    rows = [[fmt(v, 5) for v in row] for row in t.itertuples(index=False)]
 
     def eq(f: NusseltCorrelation) -> str:
         return f"Nu = {f.a:.4g} Re^{f.b:.4g} Pr^{f.c:.4g}"
@@ -404,8 +405,8 @@ def write_sweep_report(analysis: SweepAnalysis, out_dir: Path | None = None) -> 
                       for m in analysis.members if m.result is None],
         member_fit=mf, member_error=analysis.member_fit_error,
         member_eq=eq(mf) if mf else "", member_rows=_fit_rows(mf) if mf else [],
-        member_r2=_fmt(mf.adjusted_r_squared, 4) if mf else "",
-        member_sd=_fmt(mf.residual_std, 3) if mf else "",
+        member_r2=fmt(mf.adjusted_r_squared, 4) if mf else "",
+        member_sd=fmt(mf.residual_std, 3) if mf else "",
         member_range=(f"{mf.reynolds_range[0]:.5g} < Re < {mf.reynolds_range[1]:.5g}" if mf else ""),
         step_fit=sf, step_error=analysis.step_fit_error,
         step_eq=eq(sf) if sf else "", step_rows=_fit_rows(sf) if sf else [],

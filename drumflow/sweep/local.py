@@ -26,7 +26,8 @@ from typing import IO, Any
 
 from drumflow.runner import STOP_GRACE_S
 from drumflow.sweep.executor import Attempt, Executor, Ledger
-from drumflow.sweep.spec import LocalSettings, Member, Runs, SweepError
+from drumflow.sweep.run_settings import LocalSettings, Runs
+from drumflow.sweep.spec import Member, SweepError
 
 __all__ = ["LocalExecutor", "available_cores", "member_command"]
 

@@ -38,7 +38,8 @@ from typing import Any
 from drumflow.errors import EXIT_INTERRUPTED, BadFileError, SlurmError
 from drumflow.readers import read_json, read_json_object
 from drumflow.sweep.executor import Attempt, Executor, Ledger
-from drumflow.sweep.spec import Member, Runs, SlurmSettings, SweepError, member_id
+from drumflow.sweep.run_settings import Runs, SlurmSettings
+from drumflow.sweep.spec import Member, SweepError, member_id
 
 __all__ = ["SlurmError", "SlurmExecutor", "array_spec", "slurm_version"]
 

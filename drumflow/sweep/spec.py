@@ -26,7 +26,8 @@ them (the *design*), the settings of each member run and where the members run::
 An axis is a dotted case field (``drum.rpm``), or a case section (``lifters``) whose values are
 tables merged into that section, so that coupled fields (a lifter's profile and its lip) change
 together. Every member is validated as a full case before anything runs; every problem names
-the member, its axis values and the field (:class:`SweepError`).
+the member, its axis values and the field (:class:`SweepError`). The ``[runs]`` and
+``[executor]`` tables are read by :mod:`drumflow.sweep.run_settings`.
 """
 
 from __future__ import annotations
@@ -42,7 +43,6 @@ from typing import Any, Literal
 from pydantic import BaseModel, Field, model_validator
 
 from drumflow.case import (
-    INPUT_MODEL_CONFIG,
     Case,
     case_from_dict,
     case_to_toml,
@@ -50,6 +50,7 @@ from drumflow.case import (
     validate_model,
 )
 from drumflow.errors import CaseError, SweepError
+from drumflow.sweep.run_settings import ExecutorSpec, Runs, SweepTable
 
 __all__ = [
     "AxisRange",
@@ -59,7 +60,6 @@ __all__ = [
     "expand",
     "load_sweep",
     "member_id",
-    "time_limit_seconds",
 ]
 
 _RANGE_KEYS = frozenset({"start", "stop", "num", "step"})
@@ -74,12 +74,7 @@ _RANGE_KEYS = frozenset({"start", "stop", "num", "step"})
 MAX_MEMBERS = 5_000
 
 
-class _Section(BaseModel):
-    # The one input-model config (strict types, finite numbers): drumflow.case.
-    model_config = INPUT_MODEL_CONFIG
-
-
-class AxisRange(_Section):
+class AxisRange(SweepTable):
     """Evenly spaced values from ``start`` to ``stop`` (both included).
 
     Give ``num`` (number of values) or ``step``; a Latin hypercube samples the interval
@@ -123,7 +118,7 @@ class AxisRange(_Section):
         return [self.start + i * self.step for i in range(self.count())]
 
 
-class Design(_Section):
+class Design(SweepTable):
     """How the axes combine into members."""
 
     kind: Literal["full_factorial", "latin_hypercube"] = Field(
@@ -147,16 +142,7 @@ class Design(_Section):
         return self
 
 
-class Runs(_Section):
-    """Settings of every member run."""
-
-    processes: int = Field(1, ge=1, le=1024, description="MPI ranks of each member")
-    timeout: float | None = Field(
-        None, gt=0, description="solver wall-time limit of each member, s (none: no limit)"
-    )
-
-
-class Analysis(_Section):
+class Analysis(SweepTable):
     """Settings of ``drumflow sweep DIR --analyse``."""
 
     conductivity: Literal["air", "particle"] = Field(
@@ -165,89 +151,11 @@ class Analysis(_Section):
     falling_mass: Literal["mean", "per_step"] = "mean"
 
 
-class LocalSettings(_Section):
-    """The local executor: a bounded pool of `drumflow run` processes on this machine."""
-
-    max_parallel: int | Literal["auto"] = Field(
-        "auto", description="members at once; 'auto': as many as the cores hold "
-        "(cores // runs.processes); never more than that"
-    )
-    poll_interval: float = Field(1.0, gt=0, le=600, description="status refresh, s")
-
-    @model_validator(mode="after")
-    def _positive(self) -> LocalSettings:
-        if self.max_parallel != "auto" and self.max_parallel < 1:
-            raise ValueError(f"executor.local.max_parallel = {self.max_parallel}: allowed >= 1 or 'auto'")
-        return self
-
-
-class SlurmSettings(_Section):
-    """The SLURM executor: one job array, each task one member under ``srun``."""
-
-    max_parallel: int = Field(4, ge=1, le=100_000, description="members running at once (%N)")
-    partition: str | None = Field(None, min_length=1, description="sbatch --partition")
-    account: str | None = Field(None, min_length=1, description="sbatch --account")
-    time_limit: str | None = Field(
-        None, pattern=r"^(\d+-)?\d+(:\d{2}){0,2}$",
-        description="sbatch --time per member, e.g. '02:00:00' or '1-00:00:00'",
-    )
-    stop_before_limit: int = Field(
-        300, ge=0, le=86_400,
-        description="seconds before the time limit at which a member is asked to write a restart "
-        "and stop (sbatch --signal=B:USR1@N; `drumflow stop`), so the rerun resumes from there; "
-        "0: off (the limit kills it, and it resumes from its last periodic restart)",
-    )
-    sbatch_options: list[str] = Field(
-        default_factory=list, description="more sbatch options, e.g. ['--mem=4G', '--qos=long']"
-    )
-    setup: list[str] = Field(
-        default_factory=list,
-        description="shell lines run before each member (e.g. 'module load openmpi')",
-    )
-    drumflow: str | None = Field(
-        None, min_length=1,
-        description="how the nodes start drumflow (default: this Python's `-m drumflow.cli`)",
-    )
-    poll_interval: float = Field(10.0, gt=0, le=600, description="squeue polling interval, s")
-
-    @model_validator(mode="after")
-    def _warning_inside_the_limit(self) -> SlurmSettings:
-        limit = time_limit_seconds(self.time_limit) if self.time_limit else None
-        if limit is not None and self.stop_before_limit >= limit:
-            raise ValueError(
-                f"stop_before_limit = {self.stop_before_limit} s is not below time_limit = "
-                f"{self.time_limit!r} ({limit} s): the member would be asked to stop as it starts; "
-                f"allowed: 0 (off) to {limit - 1} s")
-        return self
-
-
-def time_limit_seconds(limit: str) -> int:
-    """A SLURM time limit (``[D-]HH:MM:SS``, ``MM:SS``, ``MM``) in seconds."""
-    days, _, clock = limit.rpartition("-")
-    parts = [int(x) for x in clock.split(":")]
-    if days:  # with days, SLURM reads the clock as hours[:minutes[:seconds]]
-        parts += [0] * (3 - len(parts))
-        hours, minutes, seconds = parts
-        return ((int(days) * 24 + hours) * 60 + minutes) * 60 + seconds
-    if len(parts) == 1:
-        return parts[0] * 60
-    if len(parts) == 2:
-        return parts[0] * 60 + parts[1]
-    return (parts[0] * 60 + parts[1]) * 60 + parts[2]
-
-
-class ExecutorSpec(_Section):
-    """Where the members run."""
-
-    kind: Literal["local", "slurm"] = "local"
-    local: LocalSettings = LocalSettings()
-    slurm: SlurmSettings = SlurmSettings()
-
 
 AxisValues = list[Any] | AxisRange
 
 
-class Sweep(_Section):
+class Sweep(SweepTable):
     """A validated sweep file."""
 
     name: str = Field(min_length=1, max_length=60, pattern=r"^[A-Za-z0-9_.-]+$")

@@ -12,6 +12,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from drumflow._mpl import pyplot
 from drumflow.rundir import write_json_atomic
 from drumflow.validate.errors import ValidationDataError
 from drumflow.validate.rolling_drum import (
@@ -53,10 +54,7 @@ def write_profile_csv(path: Path, result: RollingDrumResult) -> None:
 def plot_profile(path: Path, result: RollingDrumResult, title: str) -> None:
     """Velocity down the slope against the position on the normal line: simulated line,
     measured points, and the solid-body line omega r."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     fig, ax = plt.subplots(figsize=(5.5, 5.0), dpi=120)
     s = result.simulated.position

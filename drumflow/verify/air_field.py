@@ -21,8 +21,9 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from drumflow.physics.validation import relative_error
 from drumflow.runner import Runner
-from drumflow.verify.checks import Check, relative_error
+from drumflow.verify.checks import Check
 from drumflow.verify.references import ReferenceAir, petukhov_friction_factor
 from drumflow.verify.scenes import tiny_drum
 
@@ -189,7 +190,7 @@ def sampled_profiles(
         and ``swirl`` (u_theta, counter-clockwise about +z), m/s; points inside the lifters
         are left out.
     """
-    from drumflow.air.field import fluid_mask_xy
+    from drumflow.air.field_grid import fluid_mask_xy
 
     R, L = case.drum.radius, case.drum.length
     r, theta, z = np.meshgrid(

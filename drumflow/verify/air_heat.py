@@ -26,10 +26,11 @@ import numpy as np
 import pandas as pd
 
 from drumflow.air.field import AirField
-from drumflow.air_properties import ideal_gas_density
-from drumflow.coupling.physics import AirState, ranz_marshall_h
+from drumflow.physics.air import ideal_gas_density
+from drumflow.physics.particle_air import AirState, ranz_marshall_h
+from drumflow.physics.validation import relative_error
 from drumflow.runner import Runner
-from drumflow.verify.checks import Check, relative_error
+from drumflow.verify.checks import Check
 from drumflow.verify.single_particle import PRESSURE_KPA, T0, T_AIR, run_single
 
 #: The duct: nodes across (x, y), spacing across, nodes along and their spacing, m.

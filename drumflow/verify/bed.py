@@ -21,7 +21,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from drumflow.verify.checks import Check, relative_error
+from drumflow.physics.validation import relative_error
+from drumflow.verify.checks import Check
 from drumflow.verify.references import ReferenceAir, ranz_marshall_reference
 from drumflow.verify.scenes import tiny_drum
 

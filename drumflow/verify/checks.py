@@ -66,10 +66,6 @@ class Check:
         return data
 
 
-def relative_error(measured: float, expected: float) -> float:
-    return abs(measured - expected) / abs(expected) if expected else abs(measured)
-
-
 def summary(checks: Iterable[Check]) -> dict[str, Any]:
     """Counts of passed and failed checks, independent references apart from bookkeeping."""
     every = list(checks)

@@ -42,8 +42,9 @@ from drumflow.dem.timestep import (
     hertz_contact_time,
     rayleigh_time,
 )
+from drumflow.physics.validation import relative_error
 from drumflow.runner import Runner
-from drumflow.verify.checks import Check, relative_error
+from drumflow.verify.checks import Check
 
 #: The smoke case's particle material (cases/smoke.toml) and the paper's NPK properties.
 DIAMETER = 0.008

@@ -158,7 +158,7 @@ def write_annulus_mesh(
 
 
 def _write_fields(case_dir: Path, method: str, omega1: float) -> None:
-    from foamlib import FoamFieldFile, FoamFile
+    from drumflow.air.foam_case import write_field
 
     zero = [0.0, 0.0, 0.0]
     if method == "mrf":
@@ -171,25 +171,16 @@ def _write_fields(case_dir: Path, method: str, omega1: float) -> None:
             "omega": float(omega1),
             "value": zero,
         }
-    (case_dir / "0").mkdir(parents=True, exist_ok=True)
-    for name in ("U", "p"):
-        (case_dir / "0" / name).unlink(missing_ok=True)
-    with FoamFieldFile(case_dir / "0" / "U") as f:
-        f.dimensions = FoamFile.DimensionSet(length=1, time=-1)
-        f.internal_field = zero
-        f.boundary_field = {
-            "inner": inner,
-            "outer": {"type": "noSlip"},
-            "frontAndBack": {"type": "empty"},
-        }
-    with FoamFieldFile(case_dir / "0" / "p") as f:
-        f.dimensions = FoamFile.DimensionSet(length=2, time=-2)
-        f.internal_field = 0.0
-        f.boundary_field = {
-            "inner": {"type": "zeroGradient"},
-            "outer": {"type": "zeroGradient"},
-            "frontAndBack": {"type": "empty"},
-        }
+    write_field(case_dir, "U", {"length": 1, "time": -1}, zero, {
+        "inner": inner,
+        "outer": {"type": "noSlip"},
+        "frontAndBack": {"type": "empty"},
+    })
+    write_field(case_dir, "p", {"length": 2, "time": -2}, 0.0, {
+        "inner": {"type": "zeroGradient"},
+        "outer": {"type": "zeroGradient"},
+        "frontAndBack": {"type": "empty"},
+    })
 
 
 def _write_solution(case_dir: Path, tolerance: float) -> None:

@@ -21,16 +21,17 @@ from pathlib import Path
 
 import pandas as pd
 
-from drumflow.coolers.particle_interior import (
+from drumflow.coupling.interior import InteriorSpec
+from drumflow.physics.particle_air import AirState, ranz_marshall_h
+from drumflow.physics.particle_interior import (
     Sphere,
     series_mean_temperature,
     shell_drop_error,
     shells_for_biot,
 )
-from drumflow.coupling.interior import InteriorSpec
-from drumflow.coupling.physics import AirState, ranz_marshall_h
+from drumflow.physics.validation import relative_error
 from drumflow.runner import Runner
-from drumflow.verify.checks import Check, relative_error
+from drumflow.verify.checks import Check
 from drumflow.verify.single_particle import (
     DENSITY,
     DIAMETER,
@@ -45,7 +46,7 @@ from drumflow.verify.single_particle import (
 #: its conductivity is what the check varies.
 AIR_SPEED = 1.0
 #: The issue's tolerance on the temperature drop. The shells are chosen to err by at most
-#: 0.125 % (:data:`~drumflow.coolers.particle_interior.SHELL_TOLERANCE`); Crank-Nicolson in
+#: 0.125 % (:data:`~drumflow.physics.particle_interior.SHELL_TOLERANCE`); Crank-Nicolson in
 #: time at a tenth of a second adds < 0.01 %; the thermo print carries 12 digits.
 TOLERANCE = 0.005
 #: Biot numbers of the check: near lumped, the paper's 8 mm granule (1.7), the 20 mm one (2.6).

@@ -3,10 +3,10 @@ bed, solved by OpenFOAM v1912 ``porousSimpleFoam``, against independent referenc
 
 The bed
 -------
-:func:`pour_bed` pours 1856 spheres of 4 mm into a square section 10 d wide, periodic
-on its four sides (x and y), onto a floor, and lets them settle under gravity (LIGGGHTS,
-Hertz contacts, friction 0.5): a random loose packing of voidage about 0.41 away from the
-floor. The section is periodic, not walled, because walls pack a layer of voidage ~0.5 that
+:func:`~drumflow.verify.packed_bed.pour_bed` pours 1856 spheres of 4 mm into a square section
+10 d wide, periodic on its four sides (x and y), onto a floor, and lets them settle under
+gravity (LIGGGHTS, Hertz contacts, friction 0.5): a random loose packing of voidage about 0.41
+away from the floor. The section is periodic, not walled, because walls pack a layer of voidage ~0.5 that
 carries more than its share of air (wall channelling); Ergun's constants were fitted to data
 corrected for it, so a walled bed would test the wall effect, not the law.
 
@@ -15,7 +15,8 @@ The air model
 The spheres are deposited on the air grid (cells of 2 d, :mod:`drumflow.air.solids_fraction`,
 one 1-2-1 smoothing pass), the cells are binned into porosity zones (``topoSet``
 ``cellZoneSet`` from cell lists) whose Darcy-Forchheimer coefficients come from Ergun's law at
-the cell's voidage, and ``porousSimpleFoam`` (laminar, SIMPLE) solves the superficial velocity.
+the cell's voidage, and ``porousSimpleFoam`` (laminar, SIMPLE) solves the superficial velocity
+(the cases are written by :mod:`drumflow.verify.porous_foam`).
 
 The checks (all ``kind="reference"``)
 -------------------------------------
@@ -50,57 +51,46 @@ import math
 import time
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 from scipy.optimize import brentq
 
+from drumflow.air.foam_case import write_field
 from drumflow.air.solids_fraction import (
     ERGUN,
     ErgunLaw,
-    PorosityZones,
     RectilinearGrid,
     bin_coefficients,
     deposit_solids_fraction,
-    slab_sphere_volume,
     smooth_deposition,
 )
-from drumflow.errors import AirNotConvergedError, SolverError
+from drumflow.physics.validation import relative_error
 from drumflow.runner import Runner
-from drumflow.verify.checks import Check, relative_error
+from drumflow.verify.checks import Check
+from drumflow.verify.packed_bed import DIAMETER, WIDTH_DIAMETERS, PackedBed, pour_bed
+from drumflow.verify.porous_foam import (
+    AirOfBed,
+    air_at,
+    cell_order,
+    fresh_case,
+    solve_bed_air,
+    write_block_mesh,
+    write_numerics,
+    write_porosity,
+)
 
-#: Particle diameter (m), density (kg/m^3) and the section's width in diameters.
-DIAMETER = 0.004
-PARTICLE_DENSITY = 1050.0
-WIDTH_DIAMETERS = 10
-#: Rows of 8 x 8 spheres dropped from a loose lattice: 29 rows settle to a bed ~16.8 d deep.
-LATTICE_ROWS = 29
-LATTICE_SIDE = 8
-#: Settling: Hertz with a softened modulus (as drumflow's drum decks soften theirs) for a
-#: 5e-5 s step; KE falls to ~1e-6 of its peak by 6000 steps (0.3 s).
-YOUNGS_MODULUS = 1.0e6
-SETTLE_STEPS = 6000
-#: RMS particle speed (m/s) below which the poured bed counts as settled (see pour_bed).
-SETTLED_SPEED = 0.05
-TIME_STEP = 5.0e-5
 #: Air cell size in particle diameters: 2 d cells hold ~9 spheres, so the deposited fraction
 #: scatters by 0.027 from cell to cell (measured), 0.008 after the smoothing pass.
 CELL_DIAMETERS = 2
 #: Porosity zones: bins of equal width in ln d; each zone gets the volume-mean of its
 #: cells' coefficients (:func:`~drumflow.air.solids_fraction.bin_coefficients`).
 BINS = 16
-#: Air at 30 C and 1 atm (drumflow's air table).
-AIR_TEMPERATURE_C = 30.0
 #: Particle Reynolds numbers rho U d / mu of the flow up through the bed. At 20 (checks a and
 #: c) the viscous term is 72 % of Ergun's gradient, at 120 (check a at the inertial end) the
 #: inertial one is 66 %: a 10 % change of either constant then moves one of the two gradients
 #: by more than the tolerance (a change of B alone moves the first by only 2.8 %).
 BED_REYNOLDS = 20.0
 INERTIAL_REYNOLDS = 120.0
-#: Residual target of the SIMPLE iterations (p and U).
-RESIDUAL_TARGET = 1e-7
-MAX_ITERATIONS = 4000
 
 #: Check a: Ergun's correlation itself scatters by about +-15 % about packed-bed data
 #: (Macdonald et al. 1979), but here the reference and the solver use the same constants; what
@@ -125,334 +115,6 @@ FLOW_SPLIT_TOLERANCE = 0.05
 #: the cell's velocity (measured: 0.0 % with a zone per cell, 0.38 % with 16 zones, 1.5 % with
 #: 8, 2.4 % with 4). 1 %, as the brief asks; it needs >= 16 zones.
 MOMENTUM_TOLERANCE = 0.01
-
-
-@dataclass(frozen=True)
-class PackedBed:
-    """Spheres settled by LIGGGHTS in a section periodic along x and y, on a floor at z = 0."""
-
-    positions: NDArray[np.float64]  # (n, 3), m, inside [0, width)^2 x [0, height]
-    radii: NDArray[np.float64]  # (n,), m
-    width: float  # the section's period along x and y, m
-    diameter: float
-    wall_time_s: float
-
-    @property
-    def top(self) -> float:
-        """Height of the highest sphere's top, m."""
-        return float(np.max(self.positions[:, 2] + self.radii))
-
-    def voidage(self, lower: float, upper: float) -> float:
-        """Exact mean voidage between two horizontal planes (spherical caps, no grid)."""
-        solid = slab_sphere_volume(self.positions, self.radii, lower, upper)
-        return 1.0 - solid / (self.width**2 * (upper - lower))
-
-
-def _bed_deck(width: float, seed: int) -> str:
-    """A minimal LIGGGHTS deck: spheres on a jittered loose lattice fall onto a floor."""
-    rng = np.random.default_rng(seed)
-    spacing = width / LATTICE_SIDE
-    lines = []
-    for k in range(LATTICE_ROWS):
-        for j in range(LATTICE_SIDE):
-            for i in range(LATTICE_SIDE):
-                # The jitter breaks the lattice so that the spheres settle into a random packing.
-                x, y = (np.array([i, j]) + 0.5) * spacing + rng.uniform(-0.1, 0.1, 2) * DIAMETER
-                z = (0.55 + 1.1 * k) * DIAMETER
-                lines.append(f"create_atoms 1 single {x:.9g} {y:.9g} {z:.9g} units box")
-    height = (0.6 + 1.1 * LATTICE_ROWS + 1.0) * DIAMETER
-    atoms = "\n".join(lines)
-    return f"""# Packed bed for drumflow's porous-bed verification (drumflow.verify.porous_bed).
-atom_style      granular
-atom_modify     map array
-boundary        p p f
-newton          off
-communicate     single vel yes
-units           si
-# A 1 MPa modulus (below LIGGGHTS' 5 MPa limit) keeps the time step at 5e-5 s.
-soft_particles  yes
-region          box block 0 {width:.9g} 0 {width:.9g} 0 {height:.9g} units box
-create_box      1 box
-{atoms}
-set             atom * diameter {DIAMETER} density {PARTICLE_DENSITY}
-fix m1 all property/global youngsModulus peratomtype {YOUNGS_MODULUS:g}
-fix m2 all property/global poissonsRatio peratomtype 0.45
-fix m3 all property/global coefficientRestitution peratomtypepair 1 0.2
-fix m4 all property/global coefficientFriction peratomtypepair 1 0.5
-pair_style      gran model hertz tangential history
-pair_coeff      * *
-neighbor        {0.25 * DIAMETER:g} bin
-neigh_modify    delay 0
-timestep        {TIME_STEP:g}
-fix floor all wall/gran model hertz tangential history primitive type 1 zplane 0.0
-fix grav all gravity 9.81 vector 0 0 -1
-fix integrate all nve/sphere
-compute ke all ke
-thermo_style    custom step atoms c_ke
-thermo          1000
-thermo_modify   norm no flush yes
-run             {SETTLE_STEPS}
-dump bed all custom 1 bed.dump id x y z radius
-dump_modify bed format "%d %.10g %.10g %.10g %.10g"
-run 0
-"""
-
-
-def pour_bed(work: Path, runner: Runner, seed: int = 1, processes: int = 2,
-             timeout: float = 900.0) -> PackedBed:
-    """Pour and settle the bed with LIGGGHTS; return the settled spheres.
-
-    Raises
-    ------
-    drumflow.errors.SolverError
-        LIGGGHTS failed, or the bed has not settled (the RMS speed from the last thermo
-        line's kinetic energy above :data:`SETTLED_SPEED`).
-    """
-    t0 = time.perf_counter()
-    work.mkdir(parents=True, exist_ok=True)
-    width = WIDTH_DIAMETERS * DIAMETER
-    (work / "in.bed").write_text(_bed_deck(width, seed))
-    processes = max(1, min(processes, runner.profile.cores))
-    command = runner.profile.liggghts_command("in.bed", "log.liggghts", processes)
-    runner.run("liggghts", command, work, work / "liggghts.out", timeout=timeout)
-    table = np.loadtxt(work / "bed.dump", skiprows=9, ndmin=2)
-    positions, radii = table[:, 1:4], table[:, 4]
-    ke = _last_kinetic_energy(work / "log.liggghts")
-    mass = float(np.sum(PARTICLE_DENSITY * 4.0 / 3.0 * math.pi * radii**3))
-    # Settled: the RMS speed sqrt(2 KE / m) below 5 cm/s. A settled bed of soft spheres keeps
-    # ringing in its contacts (about 1 cm/s at 6000 steps, measured), but with a contact time
-    # near 1 ms that is an amplitude of a few micrometres, 0.1 % of a diameter; a bed still
-    # flowing moves at tenths of a metre per second.
-    if not ke < 0.5 * mass * SETTLED_SPEED**2:
-        raise SolverError("liggghts", command, 0, work / "log.liggghts",
-                          None, reason=f"the bed has not settled: KE = {ke:g} J")
-    return PackedBed(positions, radii, width, DIAMETER, time.perf_counter() - t0)
-
-
-def _last_kinetic_energy(log: Path) -> float:
-    ke = math.nan
-    for line in log.read_text(errors="replace").splitlines():
-        parts = line.split()
-        if len(parts) == 3 and parts[0].isdigit():
-            try:
-                ke = float(parts[2])
-            except ValueError:
-                continue
-    return ke
-
-
-# -- the OpenFOAM cases ---------------------------------------------------------------------
-
-
-@dataclass
-class AirOfBed:
-    """The air's properties and the solved fields of one porous-bed run."""
-
-    density: float
-    viscosity: float  # dynamic, Pa s
-    cells: dict[str, NDArray[np.float64]]  # C, V, U, p (kinematic) from read_cell_fields
-    zones: PorosityZones
-    fraction: NDArray[np.float64]  # per OpenFOAM cell
-    iterations: int
-    wall_time_s: float
-
-    @property
-    def kinematic_viscosity(self) -> float:
-        return self.viscosity / self.density
-
-
-def air_at(temperature_C: float = AIR_TEMPERATURE_C) -> tuple[float, float]:
-    """Air density (ideal gas, 1 atm) and dynamic viscosity (drumflow's air table), SI."""
-    from drumflow.air_properties import dynamic_viscosity, ideal_gas_density
-
-    return ideal_gas_density(temperature_C), float(dynamic_viscosity(temperature_C))
-
-
-def _block_mesh(case_dir: Path, blocks: list[dict[str, Any]]) -> None:
-    """Write ``system/blockMeshDict`` for axis-aligned boxes, each with its own vertices (so
-    blocks touching one another are *not* joined: the shared face becomes two wall patches,
-    a baffle). Each block: ``lower``, ``upper``, ``cells``, ``prefix``; x faces are cyclic
-    when ``cyclic_x``, y faces when ``cyclic_y``; the rest are walls, except the z faces
-    named in ``z_patches`` (``(low_name, high_name)``)."""
-    vertices: list[str] = []
-    hexes: list[str] = []
-    patches: list[str] = []
-    for b in blocks:
-        lo, hi = b["lower"], b["upper"]
-        o = len(vertices)
-        for z in (lo[2], hi[2]):
-            for x, y in ((lo[0], lo[1]), (hi[0], lo[1]), (hi[0], hi[1]), (lo[0], hi[1])):
-                vertices.append(f"({x:.12g} {y:.12g} {z:.12g})")
-        n = b["cells"]
-        grading = b.get("grading", "simpleGrading (1 1 1)")
-        hexes.append(f"hex ({' '.join(str(o + i) for i in range(8))}) ({n[0]} {n[1]} {n[2]}) {grading}")
-        faces = {
-            "xlo": f"({o} {o + 4} {o + 7} {o + 3})", "xhi": f"({o + 1} {o + 2} {o + 6} {o + 5})",
-            "ylo": f"({o} {o + 1} {o + 5} {o + 4})", "yhi": f"({o + 3} {o + 7} {o + 6} {o + 2})",
-            "zlo": f"({o} {o + 3} {o + 2} {o + 1})", "zhi": f"({o + 4} {o + 5} {o + 6} {o + 7})",
-        }
-        p = b["prefix"]
-        walls: list[str] = []
-        for axis in ("x", "y"):
-            if b.get(f"cyclic_{axis}"):
-                for side, other in (("lo", "hi"), ("hi", "lo")):
-                    patches.append(f"{p}{axis}{side} {{ type cyclic; neighbourPatch {p}{axis}{other}; "
-                                   f"faces ({faces[axis + side]}); }}")
-            else:
-                walls += [faces[axis + "lo"], faces[axis + "hi"]]
-        z_names = b.get("z_patches", (None, None))
-        for side, name in zip(("lo", "hi"), z_names, strict=True):
-            if name is None:
-                walls.append(faces["z" + side])
-            else:
-                patches.append(f"{name} {{ type patch; faces ({faces['z' + side]}); }}")
-        if walls:
-            patches.append(f"{p}walls {{ type wall; faces ({' '.join(walls)}); }}")
-    text = (
-        "FoamFile { version 2.0; format ascii; class dictionary; object blockMeshDict; }\n"
-        "convertToMeters 1;\n"
-        f"vertices ({' '.join(vertices)});\n"
-        f"blocks ({' '.join(hexes)});\n"
-        "edges ();\n"
-        f"boundary ({' '.join(patches)});\n"
-        "mergePatchPairs ();\n"
-    )
-    (case_dir / "system").mkdir(parents=True, exist_ok=True)
-    (case_dir / "system" / "blockMeshDict").write_text(text)
-
-
-def _write_porosity(case_dir: Path, zones: PorosityZones) -> None:
-    """``system/topoSetDict`` (one cellZoneSet per zone, from its cell list) and
-    ``constant/porosityProperties`` (one DarcyForchheimer model per zone)."""
-    from foamlib import FoamFile
-
-    topo = case_dir / "system" / "topoSetDict"
-    topo.unlink(missing_ok=True)
-    with FoamFile(topo) as f:
-        f["actions"] = [
-            {"name": name, "type": "cellZoneSet", "action": "new", "source": "labelToCell",
-             "value": [int(c) for c in cells]}
-            for name, cells in zip(zones.names, zones.cells, strict=True)
-        ]
-    props = case_dir / "constant" / "porosityProperties"
-    props.unlink(missing_ok=True)
-    with FoamFile(props) as f:
-        for name, d, fc in zip(zones.names, zones.d, zones.f, strict=True):
-            f[name] = {
-                "type": "DarcyForchheimer",
-                "active": True,
-                "cellZone": name,
-                "DarcyForchheimerCoeffs": {
-                    "d": [float(d)] * 3,
-                    "f": [float(fc)] * 3,
-                    "coordinateSystem": {
-                        "type": "cartesian",
-                        "origin": [0.0, 0.0, 0.0],
-                        "coordinateRotation": {"type": "axesRotation", "e1": [1.0, 0.0, 0.0],
-                                               "e2": [0.0, 1.0, 0.0]},
-                    },
-                },
-            }
-
-
-def _write_field(case_dir: Path, name: str, dims: dict[str, int], internal: Any,
-                 boundary: dict[str, dict[str, Any]]) -> None:
-    from foamlib import FoamFieldFile, FoamFile
-
-    path = case_dir / "0" / name
-    path.parent.mkdir(parents=True, exist_ok=True)
-    path.unlink(missing_ok=True)
-    with FoamFieldFile(path) as f:
-        f.dimensions = FoamFile.DimensionSet(**dims)
-        f.internal_field = internal
-        f.boundary_field = boundary
-
-
-def _write_numerics(case_dir: Path, nu: float, reference_cell: bool,
-                    source: float | None = None) -> None:
-    """controlDict, fvSchemes, fvSolution (plain SIMPLE: SIMPLEC with a porosity diagonal hit a
-    floating-point exception in this build), laminar transport, optional driving source."""
-    from foamlib import FoamFile
-
-    from drumflow.air.foam_case import (
-        write_control_dict,
-        write_fv_schemes,
-        write_fv_solution,
-        write_transport,
-    )
-
-    write_control_dict(case_dir, MAX_ITERATIONS)
-    write_fv_schemes(case_dir)
-    write_fv_solution(case_dir, RESIDUAL_TARGET, ["p", "U"], consistent=False)
-    with FoamFile(case_dir / "system" / "fvSolution") as f:
-        # Conjugate gradients: the baffled duct is two unconnected regions, and only one can
-        # hold the reference cell; CG converges on the other's consistent singular system.
-        f["solvers"] = {
-            "p": {"solver": "PCG", "preconditioner": "DIC", "tolerance": 1e-12, "relTol": 0.01},
-            "U": {"solver": "smoothSolver", "smoother": "symGaussSeidel", "tolerance": 1e-14,
-                  "relTol": 0.1},
-        }
-        if reference_cell:
-            f["SIMPLE", "pRefCell"] = 0
-            f["SIMPLE", "pRefValue"] = 0.0
-    write_transport(case_dir, nu, "laminar")
-    options = case_dir / "constant" / "fvOptions"
-    options.unlink(missing_ok=True)
-    if source is not None:
-        # Written as text: foamlib drops the parentheses around the (Su Sp) pair.
-        options.write_text(
-            "FoamFile { version 2.0; format ascii; class dictionary; object fvOptions; }\n"
-            "drivingPressureGradient\n{\n    type vectorSemiImplicitSource;\n    active yes;\n"
-            "    selectionMode all;\n    volumeMode specific;\n"
-            f"    injectionRateSuSp {{ U (({source:.12g} 0 0) 0); }}\n}}\n"
-        )
-
-
-def _solve(case_dir: Path, runner: Runner, zones: PorosityZones, fraction: NDArray[np.float64],
-           density: float, viscosity: float, timeout: float) -> AirOfBed:
-    """blockMesh, topoSet, porousSimpleFoam, cell centres; return the fields."""
-    from drumflow.air.foam import latest_time, read_cell_fields, write_cell_centres
-    from drumflow.air.foam_results import ResidualParser
-    from drumflow.air.mesh import run_foam
-
-    t0 = time.perf_counter()
-    run_foam(runner, "topoSet", [], case_dir, timeout=timeout)
-    parser = ResidualParser()
-    log = run_foam(runner, "porousSimpleFoam", [], case_dir, timeout=timeout, on_line=parser)
-    history = parser.finish()
-    iterations = int(history["iteration"].iloc[-1]) if len(history) else 0
-    if not parser.converged:
-        final = {k: float(v) for k, v in history.iloc[-1].items() if k != "iteration"} if len(history) else {}
-        raise AirNotConvergedError(iterations, final, RESIDUAL_TARGET, log)
-    write_cell_centres(runner, case_dir, timeout)
-    cells = read_cell_fields(case_dir, latest_time(case_dir))
-    return AirOfBed(density, viscosity, cells, zones, fraction, iterations,
-                    time.perf_counter() - t0)
-
-
-def _cell_order(case_dir: Path, runner: Runner, timeout: float) -> NDArray[np.float64]:
-    """Cell centres of the mesh as blockMesh numbered them (before any solve)."""
-    from foamlib import FoamFieldFile
-
-    from drumflow.air.mesh import run_foam
-
-    (case_dir / "0").mkdir(exist_ok=True)
-    run_foam(runner, "postProcess", ["-funcs", "(writeCellCentres)", "-time", "0"], case_dir,
-             timeout=timeout, log_name="log.postProcess.centres")
-    centres = np.asarray(FoamFieldFile(case_dir / "0" / "C").internal_field, dtype=float).reshape(-1, 3)
-    for name in ("C", "Cx", "Cy", "Cz"):
-        # Left in 0/, they would be read back as initial fields by the later postProcess.
-        (case_dir / "0" / name).unlink(missing_ok=True)
-    return centres
-
-
-def _fresh(case_dir: Path) -> None:
-    import shutil
-
-    if case_dir.exists():
-        shutil.rmtree(case_dir)
-    (case_dir / "system").mkdir(parents=True)
-    (case_dir / "constant").mkdir()
 
 
 # -- check a and c: air blown up through the bed -----------------------------------------------
@@ -498,32 +160,32 @@ def run_bed_column(work: Path, runner: Runner, bed: PackedBed, law: ErgunLaw = E
     rho, mu = air_at()
     velocity = reynolds * mu / (rho * d)
     case_dir = work / f"column_re{reynolds:g}"
-    _fresh(case_dir)
-    _block_mesh(case_dir, [{"lower": [0.0, 0.0, bottom],
+    fresh_case(case_dir)
+    write_block_mesh(case_dir, [{"lower": [0.0, 0.0, bottom],
                             "upper": [bed.width, bed.width, float(grid.edges[2][-1])],
                             "cells": grid.shape, "prefix": "", "cyclic_x": True, "cyclic_y": True,
                             "z_patches": ("inlet", "outlet")}])
     from drumflow.air.mesh import run_foam
 
-    _write_numerics(case_dir, mu / rho, reference_cell=False)
+    write_numerics(case_dir, mu / rho, reference_cell=False)
     run_foam(runner, "blockMesh", [], case_dir, timeout=timeout)
-    centres = _cell_order(case_dir, runner, timeout)
+    centres = cell_order(case_dir, runner, timeout)
     fraction = grid.flatten(deposition.fraction)[grid.locate(centres)]
     volumes = grid.flatten(grid.cell_volumes)[grid.locate(centres)]
     zones = bin_coefficients(fraction, volumes, d, bins=bins, law=law)
-    _write_porosity(case_dir, zones)
+    write_porosity(case_dir, zones)
     cyclic = {"type": "cyclic"}
-    _write_field(case_dir, "U", {"length": 1, "time": -1}, [0.0, 0.0, velocity], {
+    write_field(case_dir, "U", {"length": 1, "time": -1}, [0.0, 0.0, velocity], {
         "inlet": {"type": "fixedValue", "value": [0.0, 0.0, velocity]},
         "outlet": {"type": "zeroGradient"},
         '"(x|y)(lo|hi)"': cyclic,
     })
-    _write_field(case_dir, "p", {"length": 2, "time": -2}, 0.0, {
+    write_field(case_dir, "p", {"length": 2, "time": -2}, 0.0, {
         "inlet": {"type": "zeroGradient"},
         "outlet": {"type": "fixedValue", "value": 0.0},
         '"(x|y)(lo|hi)"': cyclic,
     })
-    air = _solve(case_dir, runner, zones, fraction, rho, mu, timeout)
+    air = solve_bed_air(case_dir, runner, zones, fraction, rho, mu, timeout)
     # The window: cell-layer centres 5 d and 13 d above the floor, clear of the floor's loose
     # layer and of the free surface (~16.8 d) after one smoothing pass.
     window = (bottom + cell * (math.floor((5.0 * d - bottom) / cell) + 0.5),
@@ -665,9 +327,9 @@ def run_flow_split(work: Path, runner: Runner, bed: PackedBed, law: ErgunLaw = E
     open_cells = (n, round(width / (0.5 * d)), round(half / (0.5 * d)))
     gradient = OPEN_VELOCITY * width * half / rectangular_duct_flow(1.0, mu, width, half)
     case_dir = work / "split"
-    _fresh(case_dir)
+    fresh_case(case_dir)
     if baffle:
-        _block_mesh(case_dir, [
+        write_block_mesh(case_dir, [
             {"lower": [0.0, 0.0, 0.0], "upper": [length, width, half], "cells": grid.shape,
              "prefix": "bed_", "cyclic_x": True},
             {"lower": [0.0, 0.0, half], "upper": [length, width, 2.0 * half], "cells": open_cells,
@@ -675,16 +337,16 @@ def run_flow_split(work: Path, runner: Runner, bed: PackedBed, law: ErgunLaw = E
         ])
     else:
         nz_bed, nz = grid.shape[2], grid.shape[2] + open_cells[2]
-        _block_mesh(case_dir, [
+        write_block_mesh(case_dir, [
             {"lower": [0.0, 0.0, 0.0], "upper": [length, width, 2.0 * half],
              "cells": (n, n_across, nz), "prefix": "bed_", "cyclic_x": True,
              "grading": f"simpleGrading (1 1 ((0.5 {nz_bed / nz:.12g} 1) (0.5 {1 - nz_bed / nz:.12g} 1)))"},
         ])
     from drumflow.air.mesh import run_foam
 
-    _write_numerics(case_dir, mu / rho, reference_cell=True, source=gradient / rho)
+    write_numerics(case_dir, mu / rho, reference_cell=True, source=gradient / rho)
     run_foam(runner, "blockMesh", [], case_dir, timeout=timeout)
-    centres = _cell_order(case_dir, runner, timeout)
+    centres = cell_order(case_dir, runner, timeout)
     in_bed = centres[:, 2] < half
     index = grid.locate(centres)
     fraction = np.where(in_bed, grid.flatten(deposition.fraction)[np.clip(index, 0, None)], 0.0)
@@ -692,13 +354,13 @@ def run_flow_split(work: Path, runner: Runner, bed: PackedBed, law: ErgunLaw = E
     cell_volumes[in_bed] = grid.flatten(grid.cell_volumes)[index[in_bed]]
     cell_volumes[~in_bed] = length * width * half / np.prod(open_cells)
     zones = bin_coefficients(fraction, cell_volumes, d, bins=bins, law=law)
-    _write_porosity(case_dir, zones)
+    write_porosity(case_dir, zones)
     cyclic = {"type": "cyclic"}
-    _write_field(case_dir, "U", {"length": 1, "time": -1}, [0.0, 0.0, 0.0], {
+    write_field(case_dir, "U", {"length": 1, "time": -1}, [0.0, 0.0, 0.0], {
         '"(bed|open)_walls"': {"type": "noSlip"}, '"(bed|open)_x(lo|hi)"': cyclic})
-    _write_field(case_dir, "p", {"length": 2, "time": -2}, 0.0, {
+    write_field(case_dir, "p", {"length": 2, "time": -2}, 0.0, {
         '"(bed|open)_walls"': {"type": "zeroGradient"}, '"(bed|open)_x(lo|hi)"': cyclic})
-    air = _solve(case_dir, runner, zones, fraction, rho, mu, timeout)
+    air = solve_bed_air(case_dir, runner, zones, fraction, rho, mu, timeout)
     c, v, u = air.cells["C"], air.cells["V"], air.cells["U"][:, 0]
     bed_cells = c[:, 2] < half
     bed_flow = float(np.sum(u[bed_cells] * v[bed_cells]) / length)

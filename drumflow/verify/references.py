@@ -1,12 +1,12 @@
 """Independent references for the air-side physics, and the checks that need no solver.
 
-Nothing here calls :mod:`drumflow.coupling.physics` or drumflow's air table to form an
+Nothing here calls :mod:`drumflow.physics.particle_air` or drumflow's air table to form an
 expected value, so a wrong correlation, exponent or air property in the implementation shows
 up as a failed check:
 
 * air properties from CoolProp (``"Air"``: Lemmon et al. 2000 equation of state, Lemmon &
   Jacobsen 2004 viscosity and conductivity), an implementation and a data source of its own
-  (drumflow's :class:`~drumflow.coupling.physics.AirState` interpolates Incropera's Table A.4);
+  (drumflow's :class:`~drumflow.physics.particle_air.AirState` interpolates Incropera's Table A.4);
 * the standard drag curve of a sphere from Clift, Grace & Weber, *Bubbles, Drops, and
   Particles* (Academic Press, 1978), Table 5.2 (a fit to the body of drag measurements), not
   Schiller-Naumann;
@@ -24,7 +24,8 @@ from dataclasses import dataclass
 
 from scipy.optimize import brentq
 
-from drumflow.verify.checks import Check, relative_error
+from drumflow.physics.validation import relative_error
+from drumflow.verify.checks import Check
 
 G = 9.81
 KELVIN = 273.15
@@ -122,7 +123,7 @@ AIR_PROPERTY_TOLERANCE = {"density": 0.005, "viscosity": 0.01, "conductivity": 0
 
 def air_property_checks(temperatures_C: tuple[float, ...] = (30.0, 90.0)) -> list[Check]:
     """drumflow's air (``AirState``) against CoolProp at the cooler's air temperatures."""
-    from drumflow.coupling.physics import AirState
+    from drumflow.physics.particle_air import AirState
 
     checks = []
     for t in temperatures_C:
@@ -155,12 +156,12 @@ DRAG_TOLERANCE = 0.07
 def drag_curve_check(reynolds: tuple[float, ...] = (50.0, 100.0, 200.0, 500.0)) -> Check:
     """drumflow's drag law at the drum's slip Reynolds numbers against the standard curve.
 
-    The coefficient is read back from :func:`drumflow.coupling.physics.drag_force` (the force
+    The coefficient is read back from :func:`drumflow.physics.particle_air.drag_force` (the force
     the coupling applies), not from ``schiller_naumann_cd``.
     """
     import numpy as np
 
-    from drumflow.coupling.physics import AirState, drag_force
+    from drumflow.physics.particle_air import AirState, drag_force
 
     air = AirState.at(30.0)
     d = 0.008

@@ -29,6 +29,7 @@ import numpy as np
 import pandas as pd
 
 from drumflow.dem.deck import RESUME_MESH_PATTERN
+from drumflow.physics.drum_frame import drum_angle
 
 #: The resumed attempt's deck (drumflow.dem.stage).
 RESUME_DECK = "in.drum.resume"
@@ -112,7 +113,7 @@ def lifter_angle_at_resume(run_dir: Path) -> dict[str, Any]:
     first = pd.read_csv(log).iloc[0]
     omega = float(json.loads((run_dir / "dem" / "coupling.json").read_text())["omega"])
     lifter = wrap_angle(rotation_about_axis(original, moved, n), pitch)
-    air = wrap_angle(omega * float(first["time_s"]), pitch)
+    air = wrap_angle(drum_angle(omega, float(first["time_s"])), pitch)
     return {
         "resume_step": resume_step,
         "coupling_first_step": int(first["step"]),

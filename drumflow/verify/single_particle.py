@@ -30,11 +30,12 @@ import pandas as pd
 
 from drumflow.coupling import driver_command
 from drumflow.coupling.interior import InteriorSpec, shell_fix_command
-from drumflow.coupling.physics import AirState, auto_coupling_interval, ranz_marshall_h
 from drumflow.dem.deck import render_deck
 from drumflow.dem.thermo import ThermoParser
+from drumflow.physics.particle_air import AirState, auto_coupling_interval, ranz_marshall_h
+from drumflow.physics.validation import relative_error
 from drumflow.runner import Runner
-from drumflow.verify.checks import Check, relative_error
+from drumflow.verify.checks import Check
 from drumflow.verify.references import (
     DRAG_TOLERANCE,
     ReferenceAir,
@@ -62,7 +63,7 @@ H_TOLERANCE = 0.02
 #: many or too few in any interval (1 / 4,600 steps = 2e-4).
 HOLD_TOLERANCE = 1e-6
 #: drumflow's 'auto' coupling interval is chosen to hold the explicit-hold error near 0.1%
-#: (:func:`drumflow.coupling.physics.auto_coupling_interval`).
+#: (:func:`drumflow.physics.particle_air.auto_coupling_interval`).
 AUTO_TOLERANCE = 1e-3
 
 

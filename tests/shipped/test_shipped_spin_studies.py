@@ -1,5 +1,5 @@
 """The shipped spin studies (results/bench/paper_model_one_settings, paper_model_one_spin,
-paper_model_two_spin) still say what the README's tables say.
+paper_model_two_spin) still say what the tables of docs/benchmarks.md say.
 
 Shipped files only: these tests open the shipped CSV and JSON files and compare their numbers;
 no drumflow code runs, so they test no code (marker ``shipped``; tests/shipped holds them
@@ -20,7 +20,7 @@ pytestmark = pytest.mark.shipped
 
 
 def test_the_shipped_study_shows_the_numerical_spin_and_its_cause() -> None:
-    """The README's table (model one from its 5.5 s restart, 100 steps of the default step's
+    """The table in docs/benchmarks.md (model one from its 5.5 s restart, 100 steps of the default step's
     time): the default step's rotational energy is ten times a resolved step's; half and a
     quarter of the step agree (converged), and so does the default step without the tangential
     dashpot (the cause). The long run at the default step keeps about 2 J from 0.25 s on."""
@@ -38,7 +38,7 @@ def test_the_shipped_study_shows_the_numerical_spin_and_its_cause() -> None:
 
 
 def test_the_whole_run_study_shows_the_old_steps_bias_on_the_flow() -> None:
-    """results/bench/paper_model_two_spin (the README's table): over 17.5 s of model two's
+    """results/bench/paper_model_two_spin (the table in docs/benchmarks.md): over 17.5 s of model two's
     parcels, the cascading bed's flow at the old step (1.61 x the spin limit) is above the half
     step's by more than twice the half step's noise floor, in both runs at the old step, which
     agree with each other within 1 %; the heat answers agree within 0.1 %."""
@@ -58,7 +58,7 @@ def test_the_whole_run_study_shows_the_old_steps_bias_on_the_flow() -> None:
 
 
 def test_the_fast_profile_run_lands_on_the_resolved_spins_answers() -> None:
-    """results/bench/paper_model_two_spin/fast (README, 'The fast profile'): without the
+    """results/bench/paper_model_two_spin/fast (docs/benchmarks.md, 'The fast profile'): without the
     tangential dashpot, at the old (contact) step, the three answers over 17.5 s are within the
     half step's noise floor and 1 % of it (the old step with the dashpot: +5.5 %), and the run
     took the old step, the dashpot off and no conduction, as its manifest records."""

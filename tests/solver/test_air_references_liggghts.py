@@ -22,7 +22,7 @@ pytestmark = [pytest.mark.solver, pytest.mark.timeout(300), requires_solver(*LIG
 _BROKEN_EXPONENT = """
     import math
     import numpy as np
-    import drumflow.coupling.physics as physics
+    import drumflow.physics.particle_air as physics
 
     def drag_force(air_velocity, particle_velocity, diameter, air):
         # Schiller-Naumann with the exponent 0.6 instead of 0.687.
@@ -37,7 +37,7 @@ _BROKEN_EXPONENT = """
 
 _CONDUCTIVITY_OFF = """
     import dataclasses
-    import drumflow.coupling.physics as physics
+    import drumflow.physics.particle_air as physics
 
     _at = physics.AirState.at.__func__
 

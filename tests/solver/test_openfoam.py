@@ -16,7 +16,8 @@ import numpy as np
 import pytest
 from support.solvers import CASES, OPENFOAM, requires_solver
 
-from drumflow.air.field import AirField, plot_air_cross_section
+from drumflow.air.field import AirField
+from drumflow.air.field_picture import plot_air_cross_section
 from drumflow.air.foam import AirNotConvergedError, AirSolution, solve_air
 from drumflow.case import Case, case_from_dict
 from drumflow.runner import Runner

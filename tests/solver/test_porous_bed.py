@@ -16,13 +16,12 @@ from support.solvers import LIGGGHTS, requires_solver
 
 from drumflow.air.solids_fraction import ErgunLaw
 from drumflow.runner import Runner
+from drumflow.verify.packed_bed import PackedBed, pour_bed
 from drumflow.verify.porous_bed import (
     INERTIAL_REYNOLDS,
-    PackedBed,
     bed_flow_split_check,
     bed_momentum_check,
     bed_pressure_drop_check,
-    pour_bed,
     run_bed_column,
     run_flow_split,
 )

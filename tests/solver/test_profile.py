@@ -84,7 +84,7 @@ def _bench_from(run: Path, case_file: Path, out: Path, *extra: str) -> subproces
 
 
 def test_settings_study_from_the_restart(run: Path, tmp_path: Path) -> None:
-    from drumflow.bench.settings import VARIANTS
+    from drumflow.bench.settings_variants import VARIANTS
     from drumflow.dem.thermo import read_thermo
 
     study = tmp_path / "study"

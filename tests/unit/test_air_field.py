@@ -12,21 +12,16 @@ from typing import Any
 import numpy as np
 import pytest
 
-from drumflow.air.field import (
-    AirField,
-    air_cache_key,
-    fluid_mask_xy,
-    local_linear_fit,
-    plot_air_cross_section,
-    rotate_to_drum_frame,
-    rotate_to_lab_frame,
-)
+from drumflow.air.field import AirField, air_cache_key
+from drumflow.air.field_grid import fluid_mask_xy, local_linear_fit
+from drumflow.air.field_picture import plot_air_cross_section
 from drumflow.air.foam_case import inlet_turbulence
 from drumflow.air.foam_results import parse_residual_log
 from drumflow.air.mesh import parse_check_mesh
 from drumflow.case import Case, case_from_dict
 from drumflow.errors import AirNotConvergedError
 from drumflow.geometry.lifters import lifter_area
+from drumflow.physics.drum_frame import rotate_to_drum_frame, rotate_to_lab_frame
 
 
 def _linear_field(shape: tuple[int, int, int] = (9, 7, 5)) -> tuple[AirField, np.ndarray, np.ndarray]:

@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from drumflow import air_properties as air
 from drumflow.errors import AnalysisInputError
+from drumflow.physics import air
 
 # Rows of Incropera & DeWitt, Fundamentals of Heat and Mass Transfer, Table A.4 (air, 1 atm),
 # typed in again here (not imported) so a wrong value in the module is caught:

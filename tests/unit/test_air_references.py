@@ -14,8 +14,8 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from drumflow.coupling import physics
-from drumflow.coupling.physics import AirState, ranz_marshall_h
+from drumflow.physics import particle_air as physics
+from drumflow.physics.particle_air import AirState, ranz_marshall_h
 from drumflow.verify.references import (
     ReferenceAir,
     air_property_checks,

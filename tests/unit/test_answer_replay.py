@@ -50,13 +50,8 @@ from support.answer_run import (
 from typer.testing import CliRunner
 
 from drumflow.analysis.methodology import analyse_run
-from drumflow.bench.answer import (
-    TEMPERATURE_TIME_S,
-    AnswerReplay,
-    replay_answer,
-    settled_time,
-    write_answer,
-)
+from drumflow.bench.answer import replay_answer, settled_time
+from drumflow.bench.answer_result import TEMPERATURE_TIME_S, AnswerReplay, write_answer
 from drumflow.cli import app
 from drumflow.convergence import mser_truncation
 from drumflow.errors import (

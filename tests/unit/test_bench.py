@@ -14,13 +14,13 @@ from drumflow.bench.ladder import (
     REFERENCE,
     apply_rung,
     ladder,
-    relative_error,
     select,
 )
 from drumflow.bench.pareto import pareto_front, plot_pareto
 from drumflow.bench.stage import TOLERANCES, _add_errors
 from drumflow.case import load_case
 from drumflow.dem.timestep import choose_time_step, rayleigh_time
+from drumflow.physics.validation import relative_error
 
 
 @pytest.fixture(scope="module")

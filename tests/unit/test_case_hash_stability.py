@@ -13,7 +13,8 @@ from __future__ import annotations
 
 import json
 
-from drumflow.case import _ADDED_LATER, Case, case_from_dict, read_toml
+from drumflow.case import Case, case_from_dict, read_toml
+from drumflow.case.model import _ADDED_LATER
 
 #: The smoke case as it stood (all sections explicit, no later option set).
 CASE_TEXT = """

@@ -253,8 +253,8 @@ def test_a_member_summary_is_done_missing_or_refused(tmp_path: Path) -> None:
 
 
 def _slurm(root: Path):  # type: ignore[no-untyped-def]
+    from drumflow.sweep.run_settings import Runs, SlurmSettings
     from drumflow.sweep.slurm import SlurmExecutor
-    from drumflow.sweep.spec import Runs, SlurmSettings
 
     return SlurmExecutor(root, SlurmSettings(), Runs(processes=2), "demo", 3)
 
@@ -316,7 +316,7 @@ def test_a_nan_wall_time_in_the_run_record_is_refused(tmp_path: Path) -> None:
     time NaN."""
     import pandas as pd
 
-    from drumflow.bench.answer import _rate_from_record
+    from drumflow.bench.answer_wall import rate_from_record as _rate_from_record
     from drumflow.rundir import RunDir
 
     rundir = RunDir(tmp_path / "run")
@@ -363,7 +363,7 @@ def test_a_gzipped_crossing_table_still_reads(tmp_path: Path) -> None:
 def test_a_damaged_summary_of_a_finished_paper_run_is_refused(tmp_path: Path) -> None:
     """Regression: `drumflow paper` took a run whose summary.json was cut short for an
     unfinished one and ran the model again over it, without a word."""
-    from drumflow.cli_paper import _finished
+    from drumflow.cli.paper import _finished
 
     run = tmp_path / "model_two"
     (run / "stages").mkdir(parents=True)

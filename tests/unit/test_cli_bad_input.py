@@ -114,7 +114,7 @@ CASES_BAD: list[tuple[str, Setup, list[str]]] = [
 
 
 def _cooler_commands() -> set[str]:
-    from drumflow.cli_cooler._app import app
+    from drumflow.cli.cooler._app import app
 
     return {c.name or (c.callback.__name__ if c.callback else "") for c in app.registered_commands}
 

@@ -245,7 +245,7 @@ def test_integers_stay_accepted_for_float_fields(tmp_path: Path) -> None:
     """Strict types refuse text, not an integer where a float is expected (rpm = 15)."""
     from drumflow.case import load_case
     from drumflow.coolers.curtain import CurtainCase
-    from drumflow.coolers.fluid_bed import load_fluid_bed_case
+    from drumflow.coolers.fluid_bed_case import load_fluid_bed_case
     from drumflow.coolers.grate.case import load_grate_case
     from drumflow.sweep.spec import load_sweep
 
@@ -283,14 +283,13 @@ def test_rich_prints_emoji_codes_as_written(tmp_path: Path) -> None:
 def test_every_cli_console_is_made_without_emoji() -> None:
     """Every command's console comes from cli_console, which turns emoji codes off."""
     import drumflow.cli as cli
-    import drumflow.cli_cooler._app as cooler
-    import drumflow.cli_sweep as cli_sweep
+    import drumflow.cli.cooler._app as cooler
+    import drumflow.cli.studies as studies
 
     consoles = [cli.console, cli.err_console, cooler.console, cooler.err_console,
-                cli_sweep.console, cli_sweep.err_console]
+                studies.console, studies.err_console]
     for console in consoles:
         assert console._emoji is False
     package = Path(cli.__file__).parent
-    sources = [*package.glob("cli*.py"), *(package / "cli_cooler").glob("*.py")]
-    made_here = [p.name for p in sources if "Console(" in p.read_text()]
-    assert made_here == ["cli_guard.py"], made_here
+    made_here = [p.name for p in package.rglob("*.py") if "Console(" in p.read_text()]
+    assert made_here == ["_guard.py"], made_here

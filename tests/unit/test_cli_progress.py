@@ -1,4 +1,4 @@
-"""Progress lines of a run in a log file (drumflow.cli_progress): a background run's log was
+"""Progress lines of a run in a log file (drumflow.cli._progress): a background run's log was
 empty until the end, because rich draws its bars only on a terminal."""
 
 from __future__ import annotations
@@ -7,7 +7,7 @@ import io
 
 from rich.console import Console
 
-from drumflow.cli_progress import StageProgress
+from drumflow.cli._progress import StageProgress
 
 
 class _Clock:
@@ -71,7 +71,7 @@ def test_tables_off_a_terminal_are_not_cut_at_80_columns(monkeypatch) -> None:
 
     from rich.table import Table
 
-    from drumflow.cli_guard import LOG_WIDTH, cli_console
+    from drumflow.cli._guard import LOG_WIDTH, cli_console
 
     monkeypatch.delenv("COLUMNS", raising=False)
     monkeypatch.setattr("sys.stdout", io.StringIO())

@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 
 from drumflow.coupling.driver import air_load
-from drumflow.coupling.physics import AirState, convective_heat, drag_force
 from drumflow.coupling.spec import CouplingSpec
 from drumflow.errors import CaseError
+from drumflow.physics.particle_air import AirState, convective_heat, drag_force
 from drumflow.verify.scenes import tiny_drum
 
 

@@ -11,10 +11,10 @@ from scipy import stats
 
 from drumflow.analysis.correlation import (
     CorrelationRangeWarning,
-    anova_table,
     fit_nusselt_correlation,
     fit_nusselt_correlation_from_runs,
 )
+from drumflow.analysis.fit_statistics import anova_table
 from drumflow.errors import AnalysisInputError
 
 # Paper, Eq. 58 and Table 8.

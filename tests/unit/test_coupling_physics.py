@@ -10,7 +10,7 @@ import pytest
 
 from drumflow.coupling.driver import UniformAir, air_velocity_at
 from drumflow.coupling.log import read_coupling
-from drumflow.coupling.physics import (
+from drumflow.physics.particle_air import (
     AirState,
     auto_coupling_interval,
     convective_heat,
@@ -142,7 +142,7 @@ def test_coupling_log_sums_ranks_and_supersedes_attempts(tmp_path: Path) -> None
 def test_ranz_marshall_slip_inverts_the_correlation() -> None:
     """The slip a published h needs: Eq. 23 solved for Re gives back h, and below the
     still-air limit 2 k / d no slip gives it (NaN, not a negative speed)."""
-    from drumflow.coupling.physics import ranz_marshall_slip
+    from drumflow.physics.particle_air import ranz_marshall_slip
 
     air = AirState.at(30.0, 101.3)
     for h, d in ((60.15, 0.008), (38.93, 0.02), (500.0, 0.001)):

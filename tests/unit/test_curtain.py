@@ -12,8 +12,8 @@ import pytest
 from drumflow.case import read_toml, validate_model
 from drumflow.coolers._propagator import apply, exposure_matrix
 from drumflow.coolers.curtain import CurtainCase, solve_curtain
-from drumflow.coolers.particle_interior import Sphere, SphereConduction
 from drumflow.errors import CaseError
+from drumflow.physics.particle_interior import Sphere, SphereConduction
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 

@@ -9,9 +9,9 @@ import math
 import pytest
 
 from drumflow.analysis.closures import SliceClosures
-from drumflow.analysis.predict import PAPER_PLANT
 from drumflow.coolers._transport import TransportLaw, calibrate
 from drumflow.coolers.drum import DrumModelError, DrumOptions, solve_drum
+from drumflow.coolers.plant import PAPER_PLANT
 
 # Closures of the order a 0.4 m slice gives (smoke case): per metre of drum.
 CLOSURES = SliceClosures(
@@ -105,7 +105,7 @@ def test_bad_input_names_the_field() -> None:
 
 def test_the_plants_own_slice_needs_no_scaling() -> None:
     """results/paper/model_one/post/closures.json: the closures of paper model one, a 0.1 m slice of
-    the plant itself (README, 'The plant's own slice'). Its drum is the plant's, and its hold-up
+    the plant itself (docs/plant.md, 'The plant's own slice'). Its drum is the plant's, and its hold-up
     per metre, set from the paper's particle count, is the one the plant's measured residence
     time gives (feed x 30 min / 19 m): two independent routes to one number. So the drum model
     must carry the falling flow, falls per revolution and fall height over unchanged."""

@@ -11,7 +11,6 @@ import numpy as np
 import pytest
 from test_drum_model import CLOSURES
 
-from drumflow.analysis.predict import PAPER_PLANT
 from drumflow.coolers._curtain_pass import curtain_pass
 from drumflow.coolers._propagator import exposure_matrix
 from drumflow.coolers._transport import calibrate
@@ -21,8 +20,9 @@ from drumflow.coolers.curtain_air import (
     sweep_curtain_air,
 )
 from drumflow.coolers.drum import DrumModelError, DrumOptions, solve_drum
-from drumflow.coolers.particle_interior import Sphere, SphereConduction
+from drumflow.coolers.plant import PAPER_PLANT
 from drumflow.coolers.plant_balance import measured_balance, shell_loss_coefficient
+from drumflow.physics.particle_interior import Sphere, SphereConduction
 
 # The hand-written closures of test_drum_model (a 0.4 m slice), shared with it.
 SMALL = PAPER_PLANT.changed(length_m=6.0, feed_rate_kg_s=4.0, air_mass_flow_kg_s=8.0)

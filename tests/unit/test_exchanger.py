@@ -20,7 +20,9 @@ import math
 
 import pytest
 
-from drumflow.analysis.exchanger import (
+from drumflow.analysis.heat_transfer import falling_particle_area
+from drumflow.errors import AnalysisInputError
+from drumflow.physics.exchanger import (
     ExchangerResult,
     InfeasibleExchangerError,
     area_for_outlet_temperature,
@@ -28,8 +30,6 @@ from drumflow.analysis.exchanger import (
     exchanger_area_from_section,
     solve_outlet_temperature,
 )
-from drumflow.analysis.heat_transfer import falling_particle_area
-from drumflow.errors import AnalysisInputError
 
 PLANT = dict(
     material_mass_flow_kg_s=13.88889,
@@ -273,7 +273,7 @@ def test_section_area_rejects_bad_lengths() -> None:
 def test_pinched_exchanger_returns_the_air_limited_outlet() -> None:
     """Regression: a huge area for little air made brentq fail ('f(a) and f(b) must have
     different signs') and `drumflow report` crash on a real sweep of small drums."""
-    from drumflow.analysis.exchanger import solve_outlet_temperature
+    from drumflow.physics.exchanger import solve_outlet_temperature
 
     r = solve_outlet_temperature(
         h_w_m2k=80.0, area_m2=50.0, material_mass_flow_kg_s=13.88889, material_cp_j_kgk=1465.38,

@@ -128,7 +128,7 @@ def test_an_error_in_brackets_is_printed_as_written() -> None:
 
     from rich.console import Console
 
-    from drumflow.cli_guard import guard
+    from drumflow.cli._guard import guard
 
     buffer = io.StringIO()
     with pytest.raises(typer.Exit) as exit_info, guard(Console(file=buffer, width=200)):
@@ -143,7 +143,7 @@ def test_a_requested_stop_is_not_printed_as_an_error() -> None:
 
     from rich.console import Console
 
-    from drumflow.cli_guard import guard
+    from drumflow.cli._guard import guard
 
     buffer = io.StringIO()
     with pytest.raises(typer.Exit) as exit_info, guard(Console(file=buffer, width=200)):

@@ -1,7 +1,7 @@
 """The fast profile (``drumflow run --fast``, drumflow.case.fast_profile): what it changes, that
 the changed case is a case of its own (name and hash, so its own run directory), and that
 ``drumflow check --fast`` shows the step it gives. Its answers are measured, not tested here:
-README, 'The fast profile'."""
+docs/benchmarks.md, 'The fast profile'."""
 
 from __future__ import annotations
 

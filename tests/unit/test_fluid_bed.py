@@ -14,9 +14,10 @@ from typer.testing import CliRunner
 from drumflow.cli import app
 from drumflow.coolers import _fluidization as fl
 from drumflow.coolers import fluid_bed as fb
+from drumflow.coolers import fluid_bed_case as fbc
 from drumflow.coolers.fit import fit_parameters, read_points, synthetic_points, write_points
-from drumflow.coolers.particle_interior import SphereConduction
 from drumflow.errors import CaseError
+from drumflow.physics.particle_interior import SphereConduction
 
 CASE = Path(__file__).resolve().parents[2] / "cases" / "fluid_bed_npk.toml"
 
@@ -25,9 +26,9 @@ GAS = fl.HumidAir(temperature=293.15, pressure=101325.0, humidity_ratio=0.0, den
                   heat_capacity=1006.0, viscosity=1.8e-5, conductivity=0.026)
 
 
-def _case(steps: int = 200, **losses: float) -> fb.FluidBedCase:
-    case = fb.load_fluid_bed_case(CASE)
-    update: dict[str, object] = {"numerics": fb.Numerics(shells=10, steps_per_section=steps)}
+def _case(steps: int = 200, **losses: float) -> fbc.FluidBedCase:
+    case = fbc.load_fluid_bed_case(CASE)
+    update: dict[str, object] = {"numerics": fbc.Numerics(shells=10, steps_per_section=steps)}
     if losses:
         update["losses"] = case.losses.model_copy(update=losses)
     return case.model_copy(update=update)
@@ -119,7 +120,7 @@ def test_case_bed_is_physical() -> None:
     """Issue 34: the Richardson-Zaki dense phase gave section C a voidage of 0.989, a 3.63 m
     bed and 1.16 m bubbles on a 1 m deck; the two-phase bed is 0.57-0.61 and about 0.1 m deep."""
     case = _case(steps=20)
-    r = fb.run_unit(case, fb.case_conditions(case))
+    r = fb.run_unit(case, fbc.case_conditions(case))
     for s in r.sections:
         assert 0.5 < s.bed.voidage < 0.65, (s.name, s.bed.voidage)
         assert 0.05 < s.bed.bed_height < 0.2, (s.name, s.bed.bed_height)
@@ -128,7 +129,7 @@ def test_case_bed_is_physical() -> None:
 
 def test_sauter_diameter_of_a_sieve_analysis() -> None:
     # d32 = 1 / (0.5/2 + 0.5/4) mm = 2.6667 mm.
-    dist = fb.SizeDistribution(diameters_mm=[2.0, 4.0], mass_fractions=[0.5, 0.5])
+    dist = fbc.SizeDistribution(diameters_mm=[2.0, 4.0], mass_fractions=[0.5, 0.5])
     assert dist.sauter_diameter == pytest.approx(2.0 / 0.75 * 1e-3, rel=1e-12)
 
 
@@ -143,14 +144,14 @@ def test_unit_uses_the_shared_particle_solver(monkeypatch: pytest.MonkeyPatch) -
 
     monkeypatch.setattr(SphereConduction, "step", counting)
     case = _case(steps=20)
-    fb.run_unit(case, fb.case_conditions(case))
+    fb.run_unit(case, fbc.case_conditions(case))
     assert calls["n"] == 2 * 20  # every time step of both sections goes through it
 
 
 @pytest.mark.parametrize("cooled", [None, 290.0])
 def test_energy_balance_closes(cooled: float | None) -> None:
     case = _case(steps=50)
-    r = fb.run_unit(case, fb.case_conditions(case), cooled_air_temperature=cooled)
+    r = fb.run_unit(case, fbc.case_conditions(case), cooled_air_temperature=cooled)
     # Product enthalpy drop = air enthalpy gain at the measuring point + hood loss; the shell
     # solver and the slice balance conserve energy to round-off, so 1e-9 is generous.
     assert r.closure < 1e-9
@@ -159,9 +160,9 @@ def test_energy_balance_closes(cooled: float | None) -> None:
 
 
 def test_outlet_converges_with_time_steps() -> None:
-    case = fb.load_fluid_bed_case(CASE)
-    cond = fb.case_conditions(case)
-    fine_numerics = fb.Numerics(shells=20, steps_per_section=2000)
+    case = fbc.load_fluid_bed_case(CASE)
+    cond = fbc.case_conditions(case)
+    fine_numerics = fbc.Numerics(shells=20, steps_per_section=2000)
     fine = fb.run_unit(case.model_copy(update={"numerics": fine_numerics}), cond)
     coarse = fb.run_unit(case, cond)
     # The shipped numerics (10 shells, 200 steps) are within 0.01 K of 20 shells / 2000 steps
@@ -173,7 +174,7 @@ def test_losses_do_not_touch_the_product() -> None:
     # The hood loses heat from the air after it left the bed: the product outlet does not
     # depend on hLosses A, the measured air does (which is what makes the fit well posed).
     case = _case(steps=30)
-    cond = fb.case_conditions(case)
+    cond = fbc.case_conditions(case)
     a = fb.run_unit(case, cond, losses_conductance=0.0)
     b = fb.run_unit(case, cond, losses_conductance=5000.0)
     assert a.product_outlet_temperature == b.product_outlet_temperature
@@ -252,13 +253,13 @@ def _write_case(tmp_path: Path, old: str, new: str) -> Path:
 def test_bad_case_value_names_the_field(tmp_path: Path) -> None:
     path = _write_case(tmp_path, "convective_efficiency = 0.30", "convective_efficiency = 1.5")
     with pytest.raises(CaseError, match=r"losses\.convective_efficiency.*1\.5"):
-        fb.load_fluid_bed_case(path)
+        fbc.load_fluid_bed_case(path)
 
 
 def test_velocity_below_minimum_fluidization_is_refused(tmp_path: Path) -> None:
     path = _write_case(tmp_path, "velocity = 5.0", "velocity = 0.5")
     with pytest.raises(CaseError, match=r"air\.ambient\.velocity = 0\.5.*minimum"):
-        fb.load_fluid_bed_case(path)
+        fbc.load_fluid_bed_case(path)
 
 
 def test_cli_bad_case_exit_code_2_without_traceback(tmp_path: Path) -> None:
@@ -303,6 +304,6 @@ def test_cli_year_prints_the_source_table(tmp_path: Path) -> None:
 
 
 def test_weather_table_has_twelve_months() -> None:
-    months = fb.load_weather("salamanca")
+    months = fbc.load_weather("salamanca")
     assert [m.month for m in months] == list(range(1, 13))
     assert all(m.t_max_mean_C > m.t_mean_C for m in months)

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from drumflow.case import case_from_dict
+from drumflow.case.lifter_shape import lifter_gap, lifter_plates
 from drumflow.errors import GeometryError
 from drumflow.geometry.drum import (
     WallMesh,
@@ -18,7 +19,7 @@ from drumflow.geometry.drum import (
     simulation_box,
     write_ascii_stl,
 )
-from drumflow.geometry.lifters import distance_to_lifters, lifter_gap, lifter_plates
+from drumflow.geometry.lifters import distance_to_lifters
 
 
 def test_straight_lifter_gap_is_analytic(smoke_dict: dict) -> None:

@@ -14,15 +14,16 @@ from typer.testing import CliRunner
 
 from drumflow.cli import app
 from drumflow.coolers.grate import grate_case_from_dict, load_grate_case, parse_vary, solve_grate
-from drumflow.coolers.grate.model import ClinkerProperties, GrateSolution
-from drumflow.coolers.grate.properties import (
+from drumflow.coolers.grate.properties import ClinkerProperties
+from drumflow.coolers.grate.solution import GrateSolution
+from drumflow.coolers.grate.tdma import tdma
+from drumflow.errors import CaseError
+from drumflow.physics.air import (
     air_enthalpy,
     air_enthalpy_scalar,
     air_heat_capacity,
     air_temperature_from_enthalpy,
 )
-from drumflow.coolers.grate.tdma import tdma
-from drumflow.errors import CaseError
 
 CASE = Path(__file__).resolve().parents[2] / "cases" / "grate_cooler_report.toml"
 

@@ -14,7 +14,7 @@ from typing import Any
 import pytest
 from support.requirements import requires_module
 
-from drumflow.coolers.grate import properties as gp
+from drumflow.physics import air as gp
 
 CoolProp: Any
 try:

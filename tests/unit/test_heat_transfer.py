@@ -9,11 +9,11 @@ import pytest
 
 from drumflow.analysis.heat_transfer import (
     falling_particle_area,
-    log_mean_temperature_difference,
     particle_mass,
     per_step_heat_transfer,
 )
 from drumflow.errors import AnalysisInputError
+from drumflow.physics.exchanger import log_mean_temperature_difference
 
 NDArrayLike = float | np.ndarray
 

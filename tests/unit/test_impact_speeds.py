@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from drumflow.case import Case, load_case
+from drumflow.dem.collision_speed import impact_velocity
 from drumflow.dem.impacts import (
     WALL_EQUIVALENT_SPEED_FACTOR,
     ImpactSample,
@@ -19,7 +20,7 @@ from drumflow.dem.impacts import (
     wall_approaches,
     weighted_quantiles,
 )
-from drumflow.dem.timestep import choose_time_step, impact_velocity
+from drumflow.dem.timestep import choose_time_step
 from drumflow.errors import AnalysisInputError
 
 R = 0.01  # particle radius, m (the paper's 20 mm spheres)

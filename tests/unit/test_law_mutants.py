@@ -35,12 +35,12 @@ import test_laws_fluid_bed as laws_fluid_bed  # noqa: E402
 import test_laws_grate as laws_grate  # noqa: E402
 import test_laws_refrigeration as laws_refrigeration  # noqa: E402
 
-from drumflow import air_properties  # noqa: E402
-from drumflow.analysis import predict  # noqa: E402
 from drumflow.coolers import _fluidization, curtain, drum, refrigeration  # noqa: E402
+from drumflow.coolers import prediction as predict  # noqa: E402
 from drumflow.coolers.grate import model as grate_model  # noqa: E402
 from drumflow.coolers.grate import properties as grate_props  # noqa: E402
-from drumflow.coupling import physics  # noqa: E402
+from drumflow.physics import air as air_properties  # noqa: E402
+from drumflow.physics import particle_air as physics  # noqa: E402
 
 
 def mutate_source(mp: pytest.MonkeyPatch, owner: Any, name: str, old: str, new: str) -> None:
@@ -125,7 +125,7 @@ MUTANTS: tuple[Mutant, ...] = (
     Mutant("curtain gas conductivity x1.1 (outlets)", _curtain_k, laws_curtain.check_cross_flow_limit),
     Mutant("curtain gas conductivity mistyped 29.5e-3", _curtain_k_typo, laws_curtain.check_gas_table),
     Mutant("grate air conductivity x1.1",
-           lambda mp: mp.setattr(grate_props, "_K", grate_props._K * 1.1),
+           lambda mp: mp.setattr(air_properties, "_K_HOT", air_properties._K_HOT * 1.1),
            laws_air.check_grate_air_table),
     Mutant("drum film coefficient x1.5",
            lambda mp: scale_function(mp, drum, "ranz_marshall_h", 1.5),

@@ -1,5 +1,5 @@
 """Law tests of the air property tables (issue 36): drumflow's air table
-(:mod:`drumflow.air_properties`, 200-600 K) and the grate model's high-temperature table
+(:mod:`drumflow.physics.air`, 200-600 K) and the grate model's high-temperature table
 (:mod:`drumflow.coolers.grate.properties`, 250-2000 K).
 
 Independent references:
@@ -27,8 +27,7 @@ import CoolProp.CoolProp as CP
 import numpy as np
 from support.law_references import INCROPERA_A4_AIR
 
-from drumflow import air_properties
-from drumflow.coolers.grate import properties as grate_props
+from drumflow.physics import air as air_properties
 
 ATM = 101325.0
 COOLPROP_RTOL = 0.03
@@ -46,7 +45,7 @@ def _coolprop(name: str, temperature_k: float) -> float:
 
 
 def check_air_table() -> None:
-    """drumflow.air_properties against Incropera's rows, CoolProp, and row consistency."""
+    """drumflow.physics.air against Incropera's rows, CoolProp, and row consistency."""
     for t_k, (rho, cp, mu, nu, k, pr) in INCROPERA_A4_AIR.items():
         t_c = t_k - 273.15
         p = air_properties.air_properties(t_c)
@@ -82,33 +81,33 @@ def check_air_table() -> None:
 def check_grate_air_table() -> None:
     """The grate's air table against Incropera's rows, CoolProp (<= 1000 K), consistency."""
     for t_k, (_, cp, mu, _, k, pr) in INCROPERA_A4_AIR.items():
-        for what, value, ref in (("c_p", grate_props.air_heat_capacity(t_k), cp),
-                                 ("mu", grate_props.air_viscosity(t_k), mu),
-                                 ("k", grate_props.air_conductivity(t_k), k),
-                                 ("Pr", grate_props.air_prandtl(t_k), pr)):
+        for what, value, ref in (("c_p", air_properties.air_heat_capacity(t_k), cp),
+                                 ("mu", air_properties.air_viscosity(t_k), mu),
+                                 ("k", air_properties.air_conductivity(t_k), k),
+                                 ("Pr", air_properties.air_prandtl(t_k), pr)):
             _close(float(value), ref, 1e-9, f"grate {what} at {t_k:g} K vs Incropera Table A.4")
     for t_k in np.arange(250.0, 1000.1, 25.0):
         t = float(t_k)
-        _close(float(grate_props.air_conductivity(t)), _coolprop("L", t), COOLPROP_RTOL,
+        _close(float(air_properties.air_conductivity(t)), _coolprop("L", t), COOLPROP_RTOL,
                f"grate k at {t:g} K vs CoolProp")
-        _close(float(grate_props.air_viscosity(t)), _coolprop("V", t), COOLPROP_RTOL,
+        _close(float(air_properties.air_viscosity(t)), _coolprop("V", t), COOLPROP_RTOL,
                f"grate mu at {t:g} K vs CoolProp")
-        _close(float(grate_props.air_heat_capacity(t)), _coolprop("C", t), COOLPROP_RTOL,
+        _close(float(air_properties.air_heat_capacity(t)), _coolprop("C", t), COOLPROP_RTOL,
                f"grate c_p at {t:g} K vs CoolProp")
-        _close(float(grate_props.air_prandtl(t)), _coolprop("Prandtl", t), COOLPROP_RTOL,
+        _close(float(air_properties.air_prandtl(t)), _coolprop("Prandtl", t), COOLPROP_RTOL,
                f"grate Pr at {t:g} K vs CoolProp")
     # Enthalpy differences (the grate's energy balance) against CoolProp's: the integral of
     # c_p, which agrees to 0.06 %; 0.3 % allowed.
     for t1, t2 in ((300.0, 500.0), (300.0, 1000.0), (600.0, 900.0)):
-        dh = float(grate_props.air_enthalpy(t2) - grate_props.air_enthalpy(t1))
+        dh = float(air_properties.air_enthalpy(t2) - air_properties.air_enthalpy(t1))
         ref = (float(CP.PropsSI("H", "T", t2, "P", ATM, "Air"))
                - float(CP.PropsSI("H", "T", t1, "P", ATM, "Air")))
         _close(dh, ref, 3e-3, f"grate air enthalpy {t1:g}-{t2:g} K vs CoolProp")
     for t_k in np.arange(250.0, 2000.1, 50.0):
         t = float(t_k)
-        cp = float(grate_props.air_heat_capacity(t))
-        _close(cp * float(grate_props.air_viscosity(t)) / float(grate_props.air_conductivity(t)),
-               float(grate_props.air_prandtl(t)), ROW_RTOL, f"grate c_p mu / k vs Pr at {t:g} K")
+        cp = float(air_properties.air_heat_capacity(t))
+        _close(cp * float(air_properties.air_viscosity(t)) / float(air_properties.air_conductivity(t)),
+               float(air_properties.air_prandtl(t)), ROW_RTOL, f"grate c_p mu / k vs Pr at {t:g} K")
 
 
 def test_air_table_against_incropera_coolprop_and_itself() -> None:

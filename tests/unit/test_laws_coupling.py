@@ -15,7 +15,7 @@ import math
 
 import numpy as np
 
-from drumflow.coupling import physics
+from drumflow.physics import particle_air as physics
 
 AIR = physics.AirState(temperature_C=20.0, density=1.2, viscosity=1.8e-5, conductivity=0.026,
                        prandtl=0.71)

@@ -1,5 +1,5 @@
 """Law tests of the whole-drum model (:mod:`drumflow.coolers.drum`) and of the plant
-prediction (:mod:`drumflow.analysis.predict`), issue 36.
+prediction (:mod:`drumflow.coolers.prediction`), issue 36.
 
 Independent references:
 
@@ -30,10 +30,11 @@ import numpy as np
 import pytest
 from support.law_references import counter_current_effectiveness, incropera_air
 
-from drumflow.analysis import predict
 from drumflow.analysis.closures import SliceClosures
 from drumflow.case import load_case
 from drumflow.coolers import _transport, drum
+from drumflow.coolers import prediction as predict
+from drumflow.coolers.plant import PAPER_PLANT
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 
@@ -51,7 +52,7 @@ CLOSURES = SliceClosures(
 # properties stay at the 300 K row (h moves 2e-5 over that span, measured). The model is
 # linear at fixed properties, so the 1 K span loses nothing. A short residence time keeps
 # NTU near 0.6, where the outlet is sensitive to h.
-PLANT = predict.PAPER_PLANT.changed(length_m=6.0, feed_rate_kg_s=4.0, air_mass_flow_kg_s=8.0,
+PLANT = PAPER_PLANT.changed(length_m=6.0, feed_rate_kg_s=4.0, air_mass_flow_kg_s=8.0,
                                     particle_diameter_m=6e-3, air_inlet_temperature_c=26.85,
                                     material_inlet_temperature_c=27.85)
 RESIDENCE_S = 200.0
@@ -141,7 +142,7 @@ def check_curtain_lumped_epsilon_ntu() -> None:
     error in the air's capacity rate or the particles' conductance moves the rise by 5.8 %;
     the column grid (0.1 NTU each) is within 1e-4 and Cr = 1e-4 within 1e-4: 1e-3 allowed."""
     from drumflow.coolers._curtain_pass import curtain_pass
-    from drumflow.coolers.particle_interior import Sphere, SphereConduction
+    from drumflow.physics.particle_interior import Sphere, SphereConduction
 
     d, rho, cp = 3e-3, 1050.0, 1465.0
     model = SphereConduction(Sphere(d, 1.0e4, rho, cp), shells=4)

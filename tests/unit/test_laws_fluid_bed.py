@@ -28,6 +28,7 @@ import CoolProp.CoolProp as CP
 
 from drumflow.coolers import _fluidization as fl
 from drumflow.coolers import fluid_bed as fb
+from drumflow.coolers import fluid_bed_case as fbc
 
 CASE = Path(__file__).resolve().parents[2] / "cases" / "fluid_bed_npk.toml"
 # The largest product conductivity the case allows: Bi = f_c h R / k < 1e-3, lumped.
@@ -79,11 +80,11 @@ def check_bed_expansion() -> None:
     _close(bed.bed_height, 0.1000894, 1e-6, "bed height")
 
 
-def _lumped_case() -> fb.FluidBedCase:
-    case = fb.load_fluid_bed_case(CASE)
+def _lumped_case() -> fbc.FluidBedCase:
+    case = fbc.load_fluid_bed_case(CASE)
     return case.model_copy(update={
         "product": case.product.model_copy(update={"conductivity": K_LUMPED}),
-        "numerics": fb.Numerics(shells=10, steps_per_section=200)})
+        "numerics": fbc.Numerics(shells=10, steps_per_section=200)})
 
 
 def check_lumped_sections() -> None:
@@ -96,7 +97,7 @@ def check_lumped_sections() -> None:
     4 % (section B) and 1.3 % (section C).
     """
     case = _lumped_case()
-    cond = fb.case_conditions(case)
+    cond = fbc.case_conditions(case)
     r = fb.run_unit(case, cond)
     prod, unit = case.product, case.unit
     d = prod.diameter

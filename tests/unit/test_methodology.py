@@ -31,23 +31,22 @@ from support.synthetic_run import (
     write_synthetic_run,
 )
 
-from drumflow import air_properties as air
-from drumflow.analysis.exchanger import (
-    area_for_outlet_temperature,
-    exchanger_area_from_section,
-    solve_outlet_temperature,
-)
 from drumflow.analysis.heat_transfer import falling_particle_area
 from drumflow.analysis.methodology import (
-    MethodologyResult,
     MissingRunFileError,
     NoHeatTransferError,
     analyse_run,
     fit_runs,
-    plant_streams,
     write_methodology,
 )
+from drumflow.analysis.methodology_result import MethodologyResult, plant_streams
 from drumflow.errors import AnalysisInputError, RunDirectoryError
+from drumflow.physics import air
+from drumflow.physics.exchanger import (
+    area_for_outlet_temperature,
+    exchanger_area_from_section,
+    solve_outlet_temperature,
+)
 
 
 @pytest.fixture()

@@ -18,7 +18,7 @@ from support.synthetic_run import AIR_FLOW, H_TRUE
 
 from drumflow.analysis.heat_transfer import per_step_heat_transfer
 from drumflow.analysis.methodology import analyse_run
-from drumflow.analysis.paper import (
+from drumflow.analysis.published import (
     EQ58,
     PAPER_MODELS,
     PAPER_PARTICLE_CONDUCTIVITY,
@@ -28,10 +28,11 @@ from drumflow.analysis.paper import (
     eq39_as_lumped_h,
     reynolds_conversion,
 )
-from drumflow.analysis.predict import PAPER_REYNOLDS_RANGE, paper_correlation, predict_plant
 from drumflow.case import load_case
+from drumflow.coolers.prediction import PAPER_REYNOLDS_RANGE, paper_correlation, predict_plant
 from drumflow.errors import AnalysisInputError, NoHeatTransferError, RunDirectoryError
-from drumflow.report.paper import collect_paper_run, find_model_dirs, write_paper
+from drumflow.report.paper_page import write_paper
+from drumflow.report.paper_results import collect_paper_run, find_model_dirs
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 
@@ -273,7 +274,8 @@ def test_snapshot_panels_draw_first_and_last_snapshot_on_one_scale(
         tmp_path: Path, write_synthetic_run: Callable[..., Any]) -> None:
     import matplotlib.image as mpimg
 
-    from drumflow.report.paper import PARTICLES_TIMES, render_snapshot_panels
+    from drumflow.report.paper_results import PARTICLES_TIMES
+    from drumflow.report.snapshots import render_snapshot_panels
     from drumflow.rundir import RunDir
 
     root = write_synthetic_run(tmp_path / "run")
@@ -307,7 +309,7 @@ def test_dem_wall_time_of_a_resumed_run_is_its_loop_time_not_a_file_time_span(
     import json as _json
     import os
 
-    from drumflow.report.paper import run_record
+    from drumflow.report.paper_results import run_record
 
     root = write_synthetic_run(tmp_path / "run")
     summary = _json.loads((root / "summary.json").read_text())
@@ -331,7 +333,7 @@ def test_dem_wall_time_of_a_resumed_run_counts_every_attempt_not_the_last_call(
     # call only (model two's last attempt: about an hour of a 4-hour run).
     import json as _json
 
-    from drumflow.report.paper import run_record
+    from drumflow.report.paper_results import run_record
 
     root = write_synthetic_run(tmp_path / "run")
     dt = _json.loads((root / "manifest.json").read_text())["time_step"]["time_step"]

@@ -12,7 +12,8 @@ from support.chromium import assert_pictures_drawn, shots_with_red_pictures
 from support.requirements import requires_program
 from support.synthetic_run import AIR_FLOW, H_TRUE
 
-from drumflow.report.paper import collect_paper_run, write_paper
+from drumflow.report.paper_page import write_paper
+from drumflow.report.paper_results import collect_paper_run
 
 # Without Chromium: skipped on a workstation, failed under CI (support/requirements.py).
 pytestmark = [pytest.mark.chromium, requires_program("chromium")]

@@ -10,12 +10,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from drumflow.analysis.correlation import (
-    effective_sample_size,
-    fit_nusselt_correlation,
-    fit_nusselt_correlation_from_runs,
-    lag1_autocorrelation,
-)
+from drumflow.analysis.correlation import fit_nusselt_correlation, fit_nusselt_correlation_from_runs
+from drumflow.analysis.fit_statistics import effective_sample_size, lag1_autocorrelation
 
 #: Two "runs" like the paper's: 400 steps each at Re about 3073 and 7686, Re drifting slowly
 #: within a run (it moves only with the air viscosity), Pr fixed, c held at 1/3.

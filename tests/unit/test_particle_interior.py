@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from drumflow.coolers.particle_interior import (
+from drumflow.physics.particle_interior import (
     Sphere,
     SphereConduction,
     lumped_mean_temperature,

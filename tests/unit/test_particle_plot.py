@@ -22,13 +22,13 @@ def test_a_large_bed_is_drawn_from_a_seeded_sample(tmp_path: Path, monkeypatch: 
     x, y, T = r * np.cos(a), r * np.sin(a), rng.uniform(80, 90, n)
     x[:10] = np.nan  # lost particles are not drawn
     titles: list[str] = []
-    real_title = plots._plt().Axes.set_title
+    real_title = plots.pyplot().Axes.set_title
 
     def spy(ax: object, label: str, *args: object, **kwargs: object) -> object:
         titles.append(label)
         return real_title(ax, label, *args, **kwargs)
 
-    monkeypatch.setattr(plots._plt().Axes, "set_title", spy)
+    monkeypatch.setattr(plots.pyplot().Axes, "set_title", spy)
     monkeypatch.setattr(plots, "MAX_DRAWN_PARTICLES", 1_000)
     plots.plot_particles(x, y, T, case, tmp_path / "a.png", "bed")
     plots.plot_particles(x, y, T, case, tmp_path / "b.png", "bed")

@@ -18,10 +18,11 @@ from drumflow.analysis.correlation import (
     NusseltCorrelation,
     fit_nusselt_correlation,
 )
-from drumflow.analysis.exchanger import solve_outlet_temperature
-from drumflow.analysis.methodology import MethodologyResult, analyse_run, plant_streams
-from drumflow.analysis.predict import ASSUMPTIONS, PAPER_REYNOLDS_RANGE, predict_plant
+from drumflow.analysis.methodology import analyse_run
+from drumflow.analysis.methodology_result import MethodologyResult, plant_streams
+from drumflow.coolers.prediction import ASSUMPTIONS, PAPER_REYNOLDS_RANGE, predict_plant
 from drumflow.errors import AnalysisInputError
+from drumflow.physics.exchanger import solve_outlet_temperature
 
 
 @pytest.fixture(scope="module")

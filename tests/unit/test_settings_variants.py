@@ -1,4 +1,4 @@
-"""The settings study's deck edits (drumflow.bench.settings.apply_variant) that need no solver;
+"""The settings study's deck edits (drumflow.bench.settings_variants.apply_variant) that need no solver;
 tests/solver/test_profile.py runs every variant through LIGGGHTS."""
 
 from __future__ import annotations
@@ -8,11 +8,11 @@ from pathlib import Path
 
 import pytest
 
-from drumflow.bench.settings import VARIANTS, apply_variant
+from drumflow.bench.settings_variants import VARIANTS, apply_variant
 from drumflow.case import Case, load_case
+from drumflow.dem.collision_speed import typical_impact_velocity
 from drumflow.dem.restitution import calibrate_case, mean_realised_restitution, pair_properties
 from drumflow.dem.stage import plan_run
-from drumflow.dem.timestep import typical_impact_velocity
 from drumflow.errors import SettingsStudyError
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -67,10 +67,11 @@ def test_a_variant_with_the_baseline_step_keeps_the_coefficients() -> None:
 
 
 def test_the_calibration_is_exact_at_the_typical_speed_and_too_elastic_below_it() -> None:
-    """The README's table (model one): calibrated at half the free-fall speed, the contact step
-    (10 steps per free-fall contact; "auto" before the spin limit) realises e_pp = 0.1 there
-    but 0.1105 at the bed's median impact (0.14 m/s), half of it 0.1049. If the calibration
-    speed changes, this and the README change together."""
+    """The table in docs/benchmarks.md (model one, "The calibration speed"): calibrated at half
+    the free-fall speed, the contact step (10 steps per free-fall contact; "auto" before the
+    spin limit) realises e_pp = 0.1 there but 0.1105 at the bed's median impact (0.14 m/s),
+    half of it 0.1049. If the calibration speed changes, this and docs/benchmarks.md change
+    together."""
     data = load_case(ROOT / "cases" / "paper_model_one.toml").model_dump(mode="json")
     data["run"]["time_step"] = "contact"
     case = Case.model_validate(data)

@@ -8,7 +8,8 @@ import math
 import numpy as np
 import pytest
 
-from drumflow.coolers.particle_interior import (
+from drumflow.coupling.interior import InteriorLoop, InteriorSpec
+from drumflow.physics.particle_interior import (
     ShellBatch,
     Sphere,
     SphereConduction,
@@ -16,7 +17,6 @@ from drumflow.coolers.particle_interior import (
     shell_drop_error,
     shells_for_biot,
 )
-from drumflow.coupling.interior import InteriorLoop, InteriorSpec
 
 NPK = Sphere(0.008, 0.18596, 1050.0, 1465.38)
 

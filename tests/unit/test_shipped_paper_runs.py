@@ -5,7 +5,7 @@ one's shipped time-to-answer ladder is what its spec replays today.
 model_one` the same case in parcels of 2 diameters (58,430 bodies, another trajectory). With
 one-way air every particle sees the air, so their mean temperatures at 3.5 s must agree to well
 within the 0.01 K the parcels kept on model two (0.006 K); the full run's own energy balance
-must close to 1e-6 (README, issue 10).
+must close to 1e-6 (docs/paper.md, issue 10).
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ import pandas as pd
 import pytest
 
 from drumflow.bench.time_to_answer import answer_ladder, load_ladder_spec
-from drumflow.report.paper import collect_paper_run
+from drumflow.report.paper_results import collect_paper_run
 
 RESULTS = Path(__file__).resolve().parents[2] / "results"
 
@@ -34,7 +34,7 @@ def test_shipped_model_one_agrees_with_its_parcel_run() -> None:
 
 
 def test_shipped_model_one_ladder_is_what_its_spec_replays_over_one_window() -> None:
-    """The model-one ladder in the README is the replay of its spec today, and every rung answers
+    """The model-one ladder in docs/benchmarks.md is the replay of its spec today, and every rung answers
     over the full-particle run's window (the parcel run to 17.5 s cut at its end): a rung over a
     longer window than the reference would be scored against another answer."""
     folder = RESULTS / "bench" / "paper_model_one_ladder_12s"

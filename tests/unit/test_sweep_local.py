@@ -18,7 +18,8 @@ import tomli_w
 
 from drumflow.sweep.driver import open_sweep, run_sweep, statuses
 from drumflow.sweep.local import LocalExecutor
-from drumflow.sweep.spec import LocalSettings, Member, SweepError
+from drumflow.sweep.run_settings import LocalSettings
+from drumflow.sweep.spec import Member, SweepError
 
 ROOT = Path(__file__).resolve().parents[2]
 

@@ -11,8 +11,8 @@ import pytest
 from support.requirements import requires_program
 
 from drumflow.sweep.executor import Attempt
+from drumflow.sweep.run_settings import Runs, SlurmSettings
 from drumflow.sweep.slurm import SlurmExecutor
-from drumflow.sweep.spec import Runs, SlurmSettings
 
 
 def _executor(root: Path, **settings: object) -> SlurmExecutor:

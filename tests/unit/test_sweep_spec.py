@@ -12,7 +12,8 @@ import tomli_w
 
 from drumflow.case import load_case
 from drumflow.errors import exit_code
-from drumflow.sweep.spec import SweepError, load_sweep, time_limit_seconds
+from drumflow.sweep.run_settings import time_limit_seconds
+from drumflow.sweep.spec import SweepError, load_sweep
 
 ROOT = Path(__file__).resolve().parents[2]
 

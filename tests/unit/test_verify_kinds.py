@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from drumflow.coupling.physics import AirState, ranz_marshall_h
+from drumflow.physics.particle_air import AirState, ranz_marshall_h
 from drumflow.verify import single_particle as sp
 from drumflow.verify.checks import summary
 

@@ -26,7 +26,7 @@ from typing import Any, Literal
 from pydantic import BaseModel, Field, model_validator
 
 from drumflow.case import INPUT_MODEL_CONFIG, read_toml, validate_model
-from drumflow.coolers.grate.properties import AIR_T_MAX, AIR_T_MIN
+from drumflow.physics.air import AIR_T_MAX, AIR_T_MIN
 
 __all__ = [
     "Air", "Clinker", "Cooler", "Fan", "GrateCase", "Model", "Numerics", "grate_case_from_dict",

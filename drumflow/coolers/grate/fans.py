@@ -43,7 +43,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from drumflow.coolers.grate.case import Fan, GrateCase
-from drumflow.coolers.grate.properties import air_density, ergun_pressure_gradient
+from drumflow.coolers.grate.properties import ergun_pressure_gradient
+from drumflow.physics.air import air_density
 
 __all__ = [
     "BedResistance",

@@ -42,7 +42,7 @@ Particle interior
     resistance is not negligible; it is offered as an option (``model.interior_resistance
     = "jeschar"``: 1/h_eff = 1/h + d_p / (10 k_s), the quasi-steady resistance of a sphere
     with a parabolic profile, Jeschar 1964) instead of the project's transient shell solver
-    (:mod:`drumflow.coolers.particle_interior`), because the model is steady and its cells
+    (:mod:`drumflow.physics.particle_interior`), because the model is steady and its cells
     hold particles of every residence time along a layer; the report's choice ("none") is
     the default and the README gives the size of the effect.
 
@@ -96,8 +96,6 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, field
-from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -105,67 +103,29 @@ from numpy.typing import NDArray
 from drumflow.coolers.grate.case import GrateCase
 from drumflow.coolers.grate.fans import (
     bed_resistance,
-    column_pressure_drops,
-    fan_pressure,
     operating_point,
 )
 from drumflow.coolers.grate.properties import (
+    ClinkerProperties,
+    bed_specific_surface,
+    packed_bed_h,
+    radiation_conductance,
+)
+from drumflow.coolers.grate.solution import GrateSolution
+from drumflow.coolers.grate.tdma import tdma
+from drumflow.errors import GrateConvergenceError
+from drumflow.physics.air import (
     AIR_T_MAX,
     AIR_T_MIN,
-    STEFAN_BOLTZMANN,
     air_enthalpy,
     air_enthalpy_scalar,
     air_heat_capacity,
     air_temperature_from_enthalpy,
-    bed_specific_surface,
-    packed_bed_h,
 )
-from drumflow.coolers.grate.tdma import tdma
-from drumflow.errors import GrateConvergenceError
 
-__all__ = ["ClinkerProperties", "GrateConvergenceError", "GrateSolution", "solve_grate"]
+__all__ = ["GrateConvergenceError", "solve_grate"]
 
 FloatArray = NDArray[np.float64]
-
-
-@dataclass(frozen=True)
-class ClinkerProperties:
-    """Linear c_p(T) and k(T) of the clinker (T in K) and the enthalpy they imply."""
-
-    cp0: float
-    cp1: float
-    k0: float
-    k1: float
-
-    @classmethod
-    def of(cls, case: GrateCase) -> ClinkerProperties:
-        c = case.clinker
-        return cls(c.heat_capacity, c.heat_capacity_slope, c.conductivity, c.conductivity_slope)
-
-    def heat_capacity(self, t: FloatArray | float) -> FloatArray:
-        """c_p(T), J/(kg K)."""
-        return np.asarray(self.cp0 + self.cp1 * np.asarray(t), dtype=np.float64)
-
-    def conductivity(self, t: FloatArray | float) -> FloatArray:
-        """k(T) of the clinker particle, W/(m K)."""
-        return np.asarray(self.k0 + self.k1 * np.asarray(t), dtype=np.float64)
-
-    def enthalpy(self, t: FloatArray | float) -> FloatArray:
-        """h(T) = cp0 T + cp1 T^2 / 2, J/kg (zero at 0 K; only differences matter)."""
-        tt = np.asarray(t, dtype=np.float64)
-        return self.cp0 * tt + 0.5 * self.cp1 * tt * tt
-
-    def temperature(self, h: FloatArray | float) -> FloatArray:
-        """Inverse of :meth:`enthalpy` (the caloric temperature of a mixed enthalpy)."""
-        hh = np.asarray(h, dtype=np.float64)
-        if self.cp1 == 0.0:
-            return hh / self.cp0
-        # Stable root of cp1/2 T^2 + cp0 T - h = 0 (no cancellation for small cp1).
-        return 2.0 * hh / (self.cp0 + np.sqrt(self.cp0 * self.cp0 + 2.0 * self.cp1 * hh))
-
-    def secant(self, t1: FloatArray, t2: FloatArray) -> FloatArray:
-        """[h(t1) - h(t2)] / (t1 - t2): exact for a linear c_p, c_p at the mean."""
-        return self.cp0 + 0.5 * self.cp1 * (t1 + t2)
 
 
 def _air_secant(t1: FloatArray, t2: FloatArray) -> FloatArray:
@@ -175,149 +135,6 @@ def _air_secant(t1: FloatArray, t2: FloatArray) -> FloatArray:
     safe = np.where(close, 1.0, dt)
     return np.where(close, air_heat_capacity(0.5 * (t1 + t2)),
                     (air_enthalpy(t1) - air_enthalpy(t2)) / safe)
-
-
-@dataclass(frozen=True)
-class GrateSolution:
-    """The converged fields and headline numbers of one grate-cooler solve.
-
-    Arrays are indexed ``[j, i]``: layer j from the grate (0) to the bed top (m - 1), column
-    i from the kiln end (0) to the discharge (n - 1). Temperatures in K, heat in W.
-    """
-
-    case: GrateCase
-    x: FloatArray
-    y: FloatArray
-    clinker_temperature: FloatArray
-    air_temperature: FloatArray
-    freeboard_temperature: FloatArray
-    heat_transfer_coefficient: FloatArray
-    air_column_flow: FloatArray
-    bed_height: float
-    sweeps: int
-    residual: float
-    energy_imbalance: float
-    wall_time_s: float
-    history: list[tuple[int, float, float]] = field(repr=False, default_factory=list)
-
-    @property
-    def clinker(self) -> ClinkerProperties:
-        return ClinkerProperties.of(self.case)
-
-    @property
-    def caloric_temperature(self) -> FloatArray:
-        """Average caloric temperature of the clinker leaving each column, K (the report's
-        Figures 11 and 13): the temperature of the layers' mean enthalpy."""
-        props = self.clinker
-        return props.temperature(props.enthalpy(self.clinker_temperature).mean(axis=0))
-
-    @property
-    def clinker_outlet_temperature(self) -> float:
-        """Caloric temperature of the clinker leaving the grate, K."""
-        return float(self.caloric_temperature[-1])
-
-    @property
-    def secondary_air_temperature(self) -> float:
-        """Freeboard air leaving at the kiln end, K (the report's air outlet temperature)."""
-        return float(self.freeboard_temperature[0])
-
-    @property
-    def heat_duty(self) -> float:
-        """Heat the clinker would give up cooled to the air inlet temperature, W."""
-        props, c = self.clinker, self.case.clinker
-        return float(c.mass_flow * (props.enthalpy(c.inlet_temperature)
-                                    - props.enthalpy(self.case.air.inlet_temperature)))
-
-    @property
-    def clinker_heat_released(self) -> float:
-        """Heat the clinker gives up between inlet and outlet, W."""
-        props, c = self.clinker, self.case.clinker
-        h_out = float(props.enthalpy(self.clinker_temperature[:, -1]).mean())
-        return float(c.mass_flow * (float(props.enthalpy(c.inlet_temperature)) - h_out))
-
-    @property
-    def heat_recovered(self) -> float:
-        """Heat taken up by the air leaving as secondary air, W."""
-        a = self.case.air
-        return float(a.mass_flow * (air_enthalpy(self.secondary_air_temperature)
-                                    - air_enthalpy(a.inlet_temperature)))
-
-    @property
-    def efficiency(self) -> float:
-        """Recovered heat over the heat duty (share of the clinker's heat above the air inlet
-        temperature that reaches the kiln with the secondary air)."""
-        return self.heat_recovered / self.heat_duty
-
-    @property
-    def radiation_heat(self) -> float:
-        """Heat radiated by the bed top to the freeboard, W."""
-        case = self.case
-        if not case.model.radiation:
-            return 0.0
-        c_rad = _radiation_conductance(case, self.x.size)
-        top = self.clinker_temperature[-1]
-        return float(np.sum(c_rad * (top**4 - self.freeboard_temperature**4)))
-
-    @property
-    def air_flow(self) -> float:
-        """Total cooling-air mass flow, kg/s (the operating point with ``air.supply = "fan"``)."""
-        return self.case.air.mass_flow
-
-    @property
-    def column_pressure_drop(self) -> FloatArray:
-        """Ergun pressure drop across the bed of every column, Pa."""
-        return column_pressure_drops(self.case, self.air_temperature, self.air_column_flow,
-                                     self.bed_height)
-
-    @property
-    def bed_pressure_drop(self) -> float:
-        """Flow-weighted mean of the columns' bed pressure drops, Pa (what the fan sees)."""
-        shares = self.air_column_flow / self.air_column_flow.sum()
-        return float(np.sum(shares * self.column_pressure_drop))
-
-    @property
-    def fan_pressure(self) -> float | None:
-        """Pressure rise of the fan curve at the air flow, Pa (None for a given air flow)."""
-        fan = self.case.fan
-        if self.case.air.supply != "fan" or fan is None:
-            return None
-        return fan_pressure(fan, self.air_flow, self.case.air.inlet_temperature)
-
-    def summary(self) -> dict[str, Any]:
-        """Headline numbers (JSON-ready)."""
-        n, m = self.x.size, self.y.size
-        fan_p = self.fan_pressure
-        return {
-            "air_supply": self.case.air.supply,
-            "air_flow_kg_s": self.air_flow,
-            "bed_pressure_drop_Pa": self.bed_pressure_drop,
-            **({} if fan_p is None else {"fan_pressure_Pa": fan_p}),
-            "clinker_outlet_temperature_K": self.clinker_outlet_temperature,
-            "secondary_air_temperature_K": self.secondary_air_temperature,
-            "heat_recovered_MW": self.heat_recovered / 1e6,
-            "heat_duty_MW": self.heat_duty / 1e6,
-            "cooler_efficiency": self.efficiency,
-            "radiation_heat_MW": self.radiation_heat / 1e6,
-            "bed_height_m": self.bed_height,
-            "residence_time_s": self.case.cooler.length / self.case.cooler.grate_speed,
-            "h_mean_W_m2K": float(self.heat_transfer_coefficient.mean()),
-            "top_layer_outlet_K": float(self.clinker_temperature[-1, -1]),
-            "bottom_layer_outlet_K": float(self.clinker_temperature[0, -1]),
-            "cells": [n, m],
-            "sweeps": self.sweeps,
-            "residual": self.residual,
-            "energy_imbalance": self.energy_imbalance,
-            "wall_time_s": self.wall_time_s,
-        }
-
-
-def _radiation_conductance(case: GrateCase, n: int) -> float:
-    """sigma eps_s (1 - eps) dx W of one top cell, W/K^4 (zero with radiation off)."""
-    if not case.model.radiation:
-        return 0.0
-    c = case.clinker
-    dx = case.cooler.length / n
-    return STEFAN_BOLTZMANN * c.emissivity * (1.0 - c.bed_porosity) * dx * case.cooler.width
 
 
 def _air_column_flow(case: GrateCase, n: int, air_flow: float | None = None) -> FloatArray:
@@ -346,7 +163,7 @@ class _Grid:
         self.layer_flow = c.mass_flow / self.m  # Eq. (1)
         self.set_air_flow(case.air.mass_flow)
         self.surface = bed_specific_surface(c.bed_porosity, c.particle_diameter, c.sphericity)
-        self.c_rad = _radiation_conductance(case, self.n)
+        self.c_rad = radiation_conductance(case, self.n)
         self.theta = 0.5 if num.exchange == "mean" else 0.0
         self.props = ClinkerProperties.of(case)
         self.t_in = c.inlet_temperature

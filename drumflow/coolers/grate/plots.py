@@ -10,7 +10,8 @@ from typing import Any
 
 import numpy as np
 
-from drumflow.coolers.grate.model import GrateSolution
+from drumflow._mpl import pyplot
+from drumflow.coolers.grate.solution import GrateSolution
 from drumflow.coolers.grate.studies import Sweep
 
 __all__ = [
@@ -25,14 +26,6 @@ __all__ = [
 
 _LAYER_FRACTIONS = (0.0, 0.25, 0.5, 0.75, 1.0)
 
-
-def _plt() -> Any:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
 
 
 def write_csv(rows: Sequence[Mapping[str, Any]], path: Path) -> Path:
@@ -67,7 +60,7 @@ def _layers(m: int) -> list[int]:
 def plot_layers(sol: GrateSolution, path: Path, *, air: bool = False, title: str = "") -> Path:
     """Clinker (or air) temperature against length at several heights (Figures 7-9); the air
     plot adds the freeboard air."""
-    plt = _plt()
+    plt = pyplot()
     field = sol.air_temperature if air else sol.clinker_temperature
     fig, ax = plt.subplots(figsize=(6.4, 4.0), dpi=120)
     cmap = plt.get_cmap("viridis")
@@ -94,7 +87,7 @@ def plot_layers(sol: GrateSolution, path: Path, *, air: bool = False, title: str
 
 def plot_air_height(sol: GrateSolution, path: Path) -> Path:
     """Air temperature against height at several positions along the grate (Figure 10)."""
-    plt = _plt()
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(6.4, 4.0), dpi=120)
     cmap = plt.get_cmap("plasma")
     n = sol.x.size
@@ -119,7 +112,7 @@ def plot_air_height(sol: GrateSolution, path: Path) -> Path:
 
 def plot_fields(sol: GrateSolution, path: Path) -> Path:
     """Clinker and air temperature fields over the bed (x along the grate, y up)."""
-    plt = _plt()
+    plt = pyplot()
     fig, axes = plt.subplots(2, 1, figsize=(7.0, 5.2), dpi=120, sharex=True)
     lo = sol.case.air.inlet_temperature
     hi = sol.case.clinker.inlet_temperature
@@ -146,7 +139,7 @@ def _label(field: str) -> str:
 def plot_sweep(sweep: Sweep, path: Path, title: str = "") -> Path:
     """Caloric clinker temperature and freeboard air along the grate for each value of the
     varied field (Figures 11-15)."""
-    plt = _plt()
+    plt = pyplot()
     fig, axes = plt.subplots(1, 2, figsize=(10.0, 4.0), dpi=120)
     cmap = plt.get_cmap("viridis")
     k_max = max(1, len(sweep.values) - 1)
@@ -171,7 +164,7 @@ def plot_sweep(sweep: Sweep, path: Path, title: str = "") -> Path:
 def plot_sweep_outlets(sweep: Sweep, path: Path, title: str = "") -> Path:
     """Clinker outlet and secondary-air temperatures, and the cooler efficiency, against the
     varied field."""
-    plt = _plt()
+    plt = pyplot()
     rows = sweep.rows()
     x = [r[sweep.field] for r in rows]
     fig, ax = plt.subplots(figsize=(6.4, 4.0), dpi=120)
@@ -199,7 +192,7 @@ def plot_sweep_outlets(sweep: Sweep, path: Path, title: str = "") -> Path:
 def plot_sweep_recovered(sweep: Sweep, path: Path, title: str = "") -> Path:
     """Heat recovered by the air (its largest value marked) and the air flow against the
     varied field: with fan-limited air (``air.supply = "fan"``) the flow varies too."""
-    plt = _plt()
+    plt = pyplot()
     rows = sweep.rows()
     x = [r[sweep.field] for r in rows]
     fig, ax = plt.subplots(figsize=(6.4, 4.0), dpi=120)

@@ -3,12 +3,9 @@ heat-transfer correlation of the report (its Section 2.3).
 
 Air
     The report evaluates the air properties "at the film temperature" but tabulates none.
-    The project's own air table (:mod:`drumflow.air_properties`) stops at 600 K,
-    far below the 1673 K clinker inlet, so this module carries the high-temperature rows of
-    the same source: Incropera, DeWitt, Bergman, Lavine, *Fundamentals of Heat and Mass
-    Transfer*, 6th ed., Table A.4 (air at 1 atm), 250 K to 2000 K. Properties are linear
-    in temperature between rows; the enthalpy is the exact integral of that piecewise-linear
-    c_p, so an energy balance written with :func:`air_enthalpy` closes to round-off.
+    They come from the project's one air table, read in kelvin up to 2000 K (the clinker
+    enters at 1673 K): :mod:`drumflow.physics.air` (its kelvin view, Incropera Table A.4,
+    250 K to 2000 K, linear between rows, with the exact enthalpy of that c_p).
 
 Clinker
     c_p(T) = c0 + c1 T and k(T) = k0 + k1 T (T in K), from the case file; the enthalpy
@@ -43,30 +40,24 @@ Pressure drop
 
 from __future__ import annotations
 
-from bisect import bisect_right
-from typing import Final
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Final
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from drumflow.physics.air import ATMOSPHERE, air_density, air_heat_capacity, air_prandtl, air_viscosity
+
+if TYPE_CHECKING:
+    from drumflow.coolers.grate.case import GrateCase
+
 __all__ = [
-    "AIR_T_MAX",
-    "AIR_T_MIN",
     "STEFAN_BOLTZMANN",
-    "ATMOSPHERE",
-    "AIR_MOLAR_MASS",
-    "GAS_CONSTANT",
-    "air_conductivity",
-    "air_density",
-    "air_enthalpy",
-    "air_enthalpy_scalar",
-    "air_heat_capacity",
-    "air_prandtl",
-    "air_temperature_from_enthalpy",
-    "air_viscosity",
+    "ClinkerProperties",
     "bed_specific_surface",
     "ergun_pressure_gradient",
     "packed_bed_h",
+    "radiation_conductance",
 ]
 
 FloatArray = NDArray[np.float64]
@@ -74,122 +65,45 @@ FloatArray = NDArray[np.float64]
 STEFAN_BOLTZMANN: Final = 5.670374419e-8
 """Stefan-Boltzmann constant, W/(m2 K4) (CODATA 2018)."""
 
-GAS_CONSTANT: Final = 8.314462618
-"""Molar gas constant, J/(mol K) (CODATA 2018)."""
 
-AIR_MOLAR_MASS: Final = 0.0289644
-"""Molar mass of dry air, kg/mol (US Standard Atmosphere 1976)."""
+@dataclass(frozen=True)
+class ClinkerProperties:
+    """Linear c_p(T) and k(T) of the clinker (T in K) and the enthalpy they imply."""
 
-ATMOSPHERE: Final = 101325.0
-"""Pressure of the air in the bed and at the fans, Pa (the bed's few kPa are neglected)."""
+    cp0: float
+    cp1: float
+    k0: float
+    k1: float
 
-# Incropera 6th ed., Table A.4, air at 1 atm: T (K), c_p (kJ/(kg K)), mu * 1e7 (N s/m2),
-# k * 1e3 (W/(m K)), Pr. Rows 250-600 K are the same as drumflow.air_properties.
-_ROWS: Final = (
-    (250.0, 1.006, 159.6, 22.3, 0.720),
-    (300.0, 1.007, 184.6, 26.3, 0.707),
-    (350.0, 1.009, 208.2, 30.0, 0.700),
-    (400.0, 1.014, 230.1, 33.8, 0.690),
-    (450.0, 1.021, 250.7, 37.3, 0.686),
-    (500.0, 1.030, 270.1, 40.7, 0.684),
-    (550.0, 1.040, 288.4, 43.9, 0.683),
-    (600.0, 1.051, 305.8, 46.9, 0.685),
-    (650.0, 1.063, 322.5, 49.7, 0.690),
-    (700.0, 1.075, 338.8, 52.4, 0.695),
-    (750.0, 1.087, 354.6, 54.9, 0.702),
-    (800.0, 1.099, 369.8, 57.3, 0.709),
-    (850.0, 1.110, 384.3, 59.6, 0.716),
-    (900.0, 1.121, 398.1, 62.0, 0.720),
-    (950.0, 1.131, 411.3, 64.3, 0.723),
-    (1000.0, 1.141, 424.4, 66.7, 0.726),
-    (1100.0, 1.159, 449.0, 71.5, 0.728),
-    (1200.0, 1.175, 473.0, 76.3, 0.728),
-    (1300.0, 1.189, 496.0, 82.0, 0.719),
-    (1400.0, 1.207, 530.0, 91.0, 0.703),
-    (1500.0, 1.230, 557.0, 100.0, 0.685),
-    (1600.0, 1.248, 584.0, 106.0, 0.688),
-    (1700.0, 1.267, 611.0, 113.0, 0.685),
-    (1800.0, 1.286, 637.0, 120.0, 0.683),
-    (1900.0, 1.307, 663.0, 128.0, 0.677),
-    (2000.0, 1.337, 689.0, 137.0, 0.672),
-)
-_TABLE = np.asarray(_ROWS, dtype=np.float64)
-_T: Final = _TABLE[:, 0].copy()
-_CP: Final = 1e3 * _TABLE[:, 1]
-_MU: Final = 1e-7 * _TABLE[:, 2]
-_K: Final = 1e-3 * _TABLE[:, 3]
-_PR: Final = _TABLE[:, 4].copy()
-# Enthalpy at the table rows (J/kg, zero at 250 K): trapezoids are exact for linear c_p.
-_H: Final = np.concatenate(([0.0], np.cumsum(0.5 * (_CP[1:] + _CP[:-1]) * np.diff(_T))))
-_SLOPE: Final = np.diff(_CP) / np.diff(_T)
+    @classmethod
+    def of(cls, case: GrateCase) -> ClinkerProperties:
+        c = case.clinker
+        return cls(c.heat_capacity, c.heat_capacity_slope, c.conductivity, c.conductivity_slope)
 
-AIR_T_MIN: Final = float(_T[0])
-"""Lowest air temperature of the table, K."""
-AIR_T_MAX: Final = float(_T[-1])
-"""Highest air temperature of the table, K."""
+    def heat_capacity(self, t: FloatArray | float) -> FloatArray:
+        """c_p(T), J/(kg K)."""
+        return np.asarray(self.cp0 + self.cp1 * np.asarray(t), dtype=np.float64)
 
+    def conductivity(self, t: FloatArray | float) -> FloatArray:
+        """k(T) of the clinker particle, W/(m K)."""
+        return np.asarray(self.k0 + self.k1 * np.asarray(t), dtype=np.float64)
 
-def _clip(temperature: ArrayLike) -> FloatArray:
-    # The case validator keeps every inlet inside the table and the solution stays between
-    # the air and clinker inlet temperatures; clipping only guards the first iterates.
-    return np.clip(np.asarray(temperature, dtype=np.float64), AIR_T_MIN, AIR_T_MAX)
+    def enthalpy(self, t: FloatArray | float) -> FloatArray:
+        """h(T) = cp0 T + cp1 T^2 / 2, J/kg (zero at 0 K; only differences matter)."""
+        tt = np.asarray(t, dtype=np.float64)
+        return self.cp0 * tt + 0.5 * self.cp1 * tt * tt
 
+    def temperature(self, h: FloatArray | float) -> FloatArray:
+        """Inverse of :meth:`enthalpy` (the caloric temperature of a mixed enthalpy)."""
+        hh = np.asarray(h, dtype=np.float64)
+        if self.cp1 == 0.0:
+            return hh / self.cp0
+        # Stable root of cp1/2 T^2 + cp0 T - h = 0 (no cancellation for small cp1).
+        return 2.0 * hh / (self.cp0 + np.sqrt(self.cp0 * self.cp0 + 2.0 * self.cp1 * hh))
 
-def air_heat_capacity(temperature: ArrayLike) -> FloatArray:
-    """Specific heat capacity of air at 1 atm, J/(kg K), at temperature(s) in K."""
-    return np.interp(_clip(temperature), _T, _CP)
-
-
-def air_viscosity(temperature: ArrayLike) -> FloatArray:
-    """Dynamic viscosity of air at 1 atm, Pa s, at temperature(s) in K."""
-    return np.interp(_clip(temperature), _T, _MU)
-
-
-def air_conductivity(temperature: ArrayLike) -> FloatArray:
-    """Thermal conductivity of air at 1 atm, W/(m K), at temperature(s) in K."""
-    return np.interp(_clip(temperature), _T, _K)
-
-
-def air_prandtl(temperature: ArrayLike) -> FloatArray:
-    """Prandtl number of air at 1 atm at temperature(s) in K."""
-    return np.interp(_clip(temperature), _T, _PR)
-
-
-def air_enthalpy(temperature: ArrayLike) -> FloatArray:
-    """Specific enthalpy of air, J/kg, zero at 250 K: the exact integral of the tabulated
-    piecewise-linear c_p (so differences of it are the heat a stream takes up)."""
-    t = _clip(temperature)
-    k = np.clip(np.searchsorted(_T, t, side="right") - 1, 0, len(_T) - 2)
-    dt = t - _T[k]
-    return _H[k] + _CP[k] * dt + 0.5 * _SLOPE[k] * dt * dt
-
-
-_T_LIST: Final = _T.tolist()
-_H_LIST: Final = _H.tolist()
-_CP_LIST: Final = _CP.tolist()
-_SLOPE_LIST: Final = _SLOPE.tolist()
-
-
-def air_enthalpy_scalar(temperature: float) -> tuple[float, float]:
-    """:func:`air_enthalpy` and :func:`air_heat_capacity` of one temperature, in plain
-    Python (the freeboard's per-cell Newton iteration calls it thousands of times)."""
-    t = min(max(temperature, AIR_T_MIN), AIR_T_MAX)
-    k = min(max(bisect_right(_T_LIST, t) - 1, 0), len(_T_LIST) - 2)
-    dt = t - _T_LIST[k]
-    return (_H_LIST[k] + _CP_LIST[k] * dt + 0.5 * _SLOPE_LIST[k] * dt * dt,
-            _CP_LIST[k] + _SLOPE_LIST[k] * dt)
-
-
-def air_temperature_from_enthalpy(enthalpy: ArrayLike) -> FloatArray:
-    """Inverse of :func:`air_enthalpy` (exact: a quadratic per table interval)."""
-    h = np.clip(np.asarray(enthalpy, dtype=np.float64), _H[0], _H[-1])
-    k = np.clip(np.searchsorted(_H, h, side="right") - 1, 0, len(_T) - 2)
-    a = 0.5 * _SLOPE[k]
-    b = _CP[k]
-    c = _H[k] - h
-    # Root of a dt^2 + b dt + c = 0 in the stable form (no cancellation when a -> 0).
-    dt = -2.0 * c / (b + np.sqrt(np.maximum(b * b - 4.0 * a * c, 0.0)))
-    return _T[k] + dt
+    def secant(self, t1: FloatArray, t2: FloatArray) -> FloatArray:
+        """[h(t1) - h(t2)] / (t1 - t2): exact for a linear c_p, c_p at the mean."""
+        return self.cp0 + 0.5 * self.cp1 * (t1 + t2)
 
 
 def bed_specific_surface(porosity: float, diameter: float, sphericity: float) -> float:
@@ -224,15 +138,6 @@ def packed_bed_h(mass_flux: ArrayLike, film_temperature: ArrayLike, *, diameter:
     return np.where(re > 0.0, h, 0.0)
 
 
-def air_density(temperature: ArrayLike, pressure: float = ATMOSPHERE) -> FloatArray:
-    """Density of air as an ideal gas, rho = p M / (R T), kg/m3, at temperature(s) in K.
-
-    Ideal gas rather than Table A.4's density column: at 1 atm and 250-2000 K the two agree
-    to the table's rounding, and the ideal gas has no interpolation error between rows.
-    """
-    return pressure * AIR_MOLAR_MASS / (GAS_CONSTANT * _clip(temperature))
-
-
 def ergun_pressure_gradient(mass_flux: ArrayLike, temperature: ArrayLike, *, diameter: float,
                             porosity: float, sphericity: float,
                             pressure: float = ATMOSPHERE) -> FloatArray:
@@ -264,3 +169,12 @@ def ergun_pressure_gradient(mass_flux: ArrayLike, temperature: ArrayLike, *, dia
     viscous = 150.0 * mu * (1.0 - porosity) ** 2 * u / (eps3 * d_eff * d_eff)
     inertial = 1.75 * rho * (1.0 - porosity) * u * u / (eps3 * d_eff)
     return np.asarray(viscous + inertial, dtype=np.float64)
+
+
+def radiation_conductance(case: GrateCase, n: int) -> float:
+    """sigma eps_s (1 - eps) dx W of one top cell, W/K^4 (zero with radiation off)."""
+    if not case.model.radiation:
+        return 0.0
+    c = case.clinker
+    dx = case.cooler.length / n
+    return STEFAN_BOLTZMANN * c.emissivity * (1.0 - c.bed_porosity) * dx * case.cooler.width

@@ -16,7 +16,8 @@ from typing import Any, get_args
 import numpy as np
 
 from drumflow.coolers.grate.case import GrateCase, grate_case_from_dict
-from drumflow.coolers.grate.model import GrateSolution, solve_grate
+from drumflow.coolers.grate.model import solve_grate
+from drumflow.coolers.grate.solution import GrateSolution
 from drumflow.errors import CaseError
 
 __all__ = [
