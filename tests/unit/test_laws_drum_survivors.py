@@ -165,8 +165,17 @@ def check_drum_with_bed() -> None:
            "drum with bed: solids cooling vs epsilon-NTU")
     # Each cell's heat split: the bed's share of the heat is its share of the conductance
     # (lumped particles, one temperature difference per cell).
-    _close(r.heat_bed_w / r.heat_to_air_w, ua_bed / (ua_bed + ua_fall), 2e-3,
+    bed_share = ua_bed / (ua_bed + ua_fall)
+    _close(r.heat_bed_w / r.heat_to_air_w, bed_share, 2e-3,
            "bed share of the heat vs its share of the conductance")
+    _close(r.curtain_share, 1.0 - bed_share, 2e-3, "curtain share vs its share of the conductance")
+    _close(float(r.cell_bed_w.sum()) / r.heat_to_air_w, bed_share, 2e-3, "cells' bed heat")
+    _close(float(r.cell_curtain_w.sum()) / r.heat_to_air_w, 1.0 - bed_share, 2e-3,
+           "cells' curtain heat")
+    # The profile's axis: 21 faces 0.3 m apart from the solids inlet (6 m / 20 cells).
+    assert [round(z, 12) for z in r.z_m.tolist()] == [round(0.3 * i, 12) for i in range(21)]
+    # The air properties settle (a 1 K span: two or three passes), and nothing is flagged.
+    assert r.warnings == [] and 1 <= r.property_iterations < 30
 
 
 def check_unbounded_curtain_air_is_the_all_air_limit() -> None:
@@ -179,6 +188,55 @@ def check_unbounded_curtain_air_is_the_all_air_limit() -> None:
     drop = _drop_by_epsilon_ntu(_fall_conductance(r.scaled))
     _close(PLANT.material_inlet_temperature_c - r.material_outlet_c, drop, 1e-3,
            "unbounded through-curtain air vs the all-air epsilon-NTU outlet")
+    _close(r.curtain_air_kg_s_m, RHO_300 * 1.0e4, 1e-6, "through-curtain air, kg/(s m)")
+
+
+def test_all_air_reports_no_through_curtain_stream() -> None:
+    """All the air meets the curtain: an unbounded stream, no saturation (NaN, documented),
+    each cell's curtain air is the cell's air."""
+    r = drum.solve_drum(PLANT, CLOSURES, LAW, drum.DrumOptions(cells=5, lumped_particles=True))
+    assert r.curtain_air_kg_s_m == math.inf
+    assert math.isnan(r.curtain_saturation)
+    assert len(r.cell_curtain_air_out_c) == 5 and all(
+        PLANT.air_inlet_temperature_c <= t <= PLANT.material_inlet_temperature_c
+        for t in r.cell_curtain_air_out_c)
+
+
+def test_no_air_through_the_curtains_takes_no_curtain_heat() -> None:
+    """curtain_air_m3_s_m = 0 (allowed): the falls exchange with no air, only the bed takes
+    heat, and the curtain air reported is the cell's (finite)."""
+    r = drum.solve_drum(PLANT, CLOSURES, LAW,
+                        drum.DrumOptions(cells=5, lumped_particles=True, curtain_air_m3_s_m=0.0))
+    assert abs(r.heat_curtain_w) < 1e-9 * r.heat_bed_w  # round-off (6e-11 W of 3e2 W)
+    assert all(math.isfinite(t) for t in r.cell_curtain_air_out_c)
+
+
+def test_saturated_curtain_reports_saturation() -> None:
+    """A thin through-curtain stream (0.01 m3/s per metre, gas NTU ~ 60, test_laws_drum):
+    the air leaving each curtain is at the particles' temperature. Its approach
+    (T_out - T_air) / (T_solids - T_air) is 1 to within the cell's solids-temperature
+    variation (lumped, 20 cells), never above 1 (second law): 0.999 to 1.001."""
+    r = drum.solve_drum(PLANT, CLOSURES, LAW,
+                        drum.DrumOptions(cells=20, lumped_particles=True, bed_exchange=False,
+                                         curtain_air_m3_s_m=0.01))
+    assert 0.999 < r.curtain_saturation <= 1.001
+    solids_cell = 0.5 * (r.solids_c[1:] + r.solids_c[:-1])
+    rise = r.cell_curtain_air_out_c - r.air_c[1:]
+    span = r.solids_c[0] - r.air_c[-1]
+    assert all(abs(x) <= 0.01 * span for x in r.cell_curtain_air_out_c - solids_cell)
+    assert all(x > 0 for x in rise)
+    _close(r.curtain_air_kg_s_m, RHO_300 * 0.01, 1e-6, "through-curtain air, kg/(s m)")
+
+
+def test_march_is_second_order() -> None:
+    """The cell march (air at the mean of its cell's faces) is second order: 5 cells are
+    6.6e-4 from the epsilon-NTU outlet of test_laws_drum (1.6e-4 on 10; a first-order or
+    mis-weighted mean is 1.7e-3 off on 5). 1e-3 allowed."""
+    r = drum.solve_drum(PLANT, CLOSURES, LAW,
+                        drum.DrumOptions(cells=5, lumped_particles=True, bed_exchange=False))
+    drop = _drop_by_epsilon_ntu(_fall_conductance(r.scaled))
+    _close(PLANT.material_inlet_temperature_c - r.material_outlet_c, drop, 1e-3,
+           "5-cell march vs epsilon-NTU")
 
 
 WALL_PLANT = PLANT.changed(material_inlet_temperature_c=90.0)
@@ -201,6 +259,7 @@ def check_wall_loss_alone(u_wall: float = 0.8, ambient: float = 30.0) -> None:
     _close(90.0 - r.material_outlet_c, drop, 1e-3, "wall loss alone vs exp(-U pi D L / mdot c_p)")
     _close(r.wall_loss_w, PLANT.feed_rate_kg_s * PLANT.particle_heat_capacity_j_kgk * drop, 1e-3,
            "wall loss heat")
+    _close(float(r.cell_wall_w.sum()), r.wall_loss_w, 1e-9, "cells' wall loss")
 
 
 def test_scaled_closures_written_out() -> None:
@@ -263,3 +322,21 @@ def test_hold_up_filling_the_drum_is_refused() -> None:
     law = _transport.calibrate(plant, RESIDENCE_S)
     with pytest.raises(DrumModelError, match="fill the drum"):
         drum_closures.scale_closures(plant, CLOSURES, law)
+
+
+@pytest.mark.parametrize("kwargs", [
+    {"cells": 1}, {"cells": 5000}, {"shells": 2}, {"shells": 200}, {"curtain_rows": 1},
+    {"curtain_rows": 50}, {"curtain_air_m3_s_m": 0.0}, {"curtain_air_m3_s_m": 1.0e4},
+])
+def test_options_accept_their_documented_ends(kwargs: dict[str, float]) -> None:
+    drum.DrumOptions(**kwargs)  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize(("kwargs", "field"), [
+    ({"cells": 5001}, "cells"), ({"shells": 201}, "shells"), ({"curtain_rows": 51}, "curtain_rows"),
+    ({"wall_loss_w_m2k": math.inf}, "wall_loss_w_m2k"), ({"curtain_air_m3_s_m": -1.0}, "curtain_air"),
+    ({"curtain_air_m3_s_m": 1.0001e4}, "curtain_air"),
+])
+def test_options_refuse_beyond_their_ends(kwargs: dict[str, float], field: str) -> None:
+    with pytest.raises(DrumModelError, match=field):
+        drum.DrumOptions(**kwargs)  # type: ignore[arg-type]

@@ -1,0 +1,102 @@
+"""The README's measured numbers are its results files' (issue 37, item 7). The README is not
+rendered by MkDocs, so its numbers are typed; each row below names the typed text, the shipped file
+and the key it comes from (read with the documentation's own ``value`` macro), and the test fails
+when the file and the README disagree. Derived ratios are computed here from their two files."""
+
+from __future__ import annotations
+
+import importlib.util
+import json
+import re
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+README = (ROOT / "README.md").read_text(encoding="utf-8")
+
+_spec = importlib.util.spec_from_file_location("drumflow_docs_doc_numbers_readme",
+                                               ROOT / "docs" / "gen" / "doc_numbers.py")
+assert _spec and _spec.loader
+numbers = importlib.util.module_from_spec(_spec)
+sys.modules[_spec.name] = numbers
+_spec.loader.exec_module(numbers)
+
+SMOKE = "docs/smoke/smoke_bench_results.csv"
+PLANT = "docs/plant/paper_model_one_plant.json"
+SPIN = "results/bench/paper_model_two_spin/ladder.csv"
+CG_LADDER = "results/bench/paper_model_two_ladder/ladder.csv"
+
+#: (text typed in the README with its number in brackets, file, key, format). The text without
+#: the brackets is searched as it stands in a sentence; the value read from the file, formatted,
+#: must be the bracketed number.
+TYPED: list[tuple[str, str, str, str]] = [
+    ("[83.63] °C mean temperature", SMOKE, "default.mean_temperature_C", ".2f"),
+    ("[0.271] kg/s falling", SMOKE, "default.falling_mass_flow_kg_s", ".3f"),
+    ("h = [76.5] W/(m² K)", SMOKE, "default.h_W_m2K", ".1f"),
+    ("in [127] s of DEM wall time", SMOKE, "default.dem_wall_time_s", ".0f"),
+    ("3.5 s [88.10] °C", "results/bench/paper_model_two_coarse_grain/comparison.csv",
+     "quantity=mean_temperature_at_3.5_s_C:full", ".2f"),
+    ("h from Eq. 39 is [47.4]", "results/paper/model_two/post/methodology.json",
+     "heat_transfer.h_mean_W_m2K", ".1f"),
+    ("reached [12.12] s", "results/paper/model_one/summary.json", "simulated_time_s", ".2f"),
+    ("h [77.2] against", "results/paper/model_one/post/methodology.json",
+     "heat_transfer.h_mean_W_m2K", ".1f"),
+    ("predicts [30.6] °C", PLANT, "material_outlet_temperature_C", ".1f"),
+    ("needs [1.63] m³/s per", PLANT, "curtain_air.needed_for_measured_material_outlet."
+     "curtain_air_m3_s_per_m", ".2f"),
+    ("flow by [5.4] %", SPIN, "default_step.error_steady_mass_flow", ".1%"),
+    ("heat answer to\n  [0.35] %", CG_LADDER, "parcels.error_h", ".2%"),
+    ("flow by [7.5] %", CG_LADDER, "parcels.error_steady_mass_flow", ".1%"),
+]
+
+
+def _number(text: str) -> str:
+    """The bracketed number of a README phrase."""
+    found = re.search(r"\[([^]]+)\]", text)
+    assert found, f"no [number] in {text!r}"
+    return found.group(1)
+
+
+def _value(file: str, key: str, fmt: str) -> str:
+    """``key`` as the macro takes it, or ``column=label:key`` for a CSV row picked by a label."""
+    if "=" in key:
+        pick, key = key.split(":", 1)
+        column, label = pick.split("=", 1)
+        return str(numbers.value(file, key, fmt, row={column: label})).rstrip("%")
+    return str(numbers.value(file, key, fmt)).rstrip("%")
+
+
+@pytest.mark.parametrize(("text", "file", "key", "fmt"), TYPED, ids=[t[0].replace("\n", " ") for t in TYPED])
+def test_a_typed_readme_number_is_its_files(text: str, file: str, key: str, fmt: str) -> None:
+    typed = text.replace("[", "").replace("]", "")
+    assert typed in README, f"README no longer says {typed!r}: update this table with it"
+    assert _value(file, key, fmt) == _number(text), f"{file} {key}"
+
+
+def _json(path: str) -> dict:
+    return json.loads((ROOT / path).read_text())
+
+
+def test_the_coarse_graining_cost_ratio() -> None:
+    """'23 times cheaper over 17.5 s ... (821 against 18,788 s of DEM, each run's run_record.json)'."""
+    full = _json("results/paper/model_two/run_record.json")
+    parcels = _json("results/paper_parcels/model_two/run_record.json")
+    walls = [float(numbers.value(p, "dem_wall_time_s", ".0f").replace(",", ""))
+             for p in ("results/paper/model_two/run_record.json",
+                       "results/paper_parcels/model_two/run_record.json")]
+    assert full and parcels
+    assert f"{walls[1]:,.0f} against {walls[0]:,.0f} s of DEM" in README
+    assert f"{walls[0] / walls[1]:.0f} times cheaper" in README
+
+
+def test_the_fast_profile_ratio() -> None:
+    """'2.82 times the conservative reference's speed ... fast_8.0s.csv' (coupled wall times)."""
+    f = "results/bench/paper_model_one_settings/fast_8.0s.csv"
+    rows = numbers._records(f, ROOT)
+    first = next(iter(rows[0]))
+    wall = {r[first]: float(r["coupled_wall_s"]) for r in rows}
+    reference = max(wall.values())  # the conservative reference is the slowest row
+    fast = min(wall.values())
+    assert f"{reference / fast:.2f} times the conservative" in README
