@@ -107,15 +107,18 @@ def _records(file: str, root: Path) -> list[dict[str, Any]]:
     return [dict(r) for r in data]
 
 
-def _format(value: Any, fmt: str | None) -> str:
+def _format(value: Any, fmt: str | None, scale: float = 1.0) -> str:
     if fmt is None or isinstance(value, str | bool) or value is None:
         return str(value)
-    return format(value, fmt)
+    # ``scale`` turns the file's unit into the page's (W -> kW: 1e-3); a number is never rounded
+    # by hand on a page.
+    return format(value * scale if scale != 1.0 else value, fmt)
 
 
 def value(file: str, key: str, fmt: str | None = None, *, row: int | Mapping[str, Any] | None = None,
-          root: Path = REPO_ROOT) -> str:
-    """One number from a shipped results file, formatted by ``fmt`` (``".2f"``, ``",.0f"``)."""
+          scale: float = 1.0, root: Path = REPO_ROOT) -> str:
+    """One number from a shipped results file, times ``scale`` (a unit change, e.g. 1e-3 for W to
+    kW), formatted by ``fmt`` (``".2f"``, ``",.0f"``)."""
     if file.endswith(".csv"):
         rows = _records(file, root)
         if row is None and rows and key not in rows[0] and "." in key:
@@ -137,8 +140,8 @@ def value(file: str, key: str, fmt: str | None = None, *, row: int | Mapping[str
             picked = found[0]
         if key not in picked:
             raise NumberSourceError(f"{file}: no column {key!r}")
-        return _format(picked[key], fmt)
-    return _format(_json_key(_read_json(_path(file, root)), key, file), fmt)
+        return _format(picked[key], fmt, scale)
+    return _format(_json_key(_read_json(_path(file, root)), key, file), fmt, scale)
 
 
 def table(file: str, columns: Sequence[str] | None = None, fmt: str | Mapping[str, str] | None = None,

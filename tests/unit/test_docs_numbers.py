@@ -97,3 +97,9 @@ def test_raw_blocks_show_the_macros_without_quoting_numbers(results: Path) -> No
     page = '{% raw %}\n{{ value("r/missing.json", "x") }}\n{% endraw %}\n{{ value("r/nope.json", "x") }}\n'
     problems = numbers.check_page(page, "p.md", results)
     assert [(p.line, "r/nope.json" in p.error) for p in problems] == [(4, True)]
+
+
+def test_a_value_in_another_unit_is_scaled_before_it_is_formatted(tmp_path: Path) -> None:
+    (tmp_path / "r.json").write_text(json.dumps({"duty_W": 156709.4}))
+    assert numbers.value("r.json", "duty_W", ".0f", scale=1e-3, root=tmp_path) == "157"
+    assert numbers.value("r.json", "duty_W", ",.0f", root=tmp_path) == "156,709"
