@@ -103,7 +103,8 @@ class LaunchProfile:
     mpirun
         The MPI launcher; ``DRUMFLOW_MPIRUN`` overrides it.
     liggghts
-        The LIGGGHTS executable.
+        The LIGGGHTS executable: ``PREFIX/bin/liggghts`` of the build ``DRUMFLOW_LIGGGHTS_PREFIX``
+        names (:func:`liggghts_build`), else the Debian package's ``liggghts``.
     python
         The Python interpreter for drumflow's own child processes (coupling loop, renders).
     openfoam_dir
@@ -116,7 +117,7 @@ class LaunchProfile:
     """
 
     mpirun: str = field(default_factory=lambda: os.environ.get("DRUMFLOW_MPIRUN", "mpirun"))
-    liggghts: str = "liggghts"
+    liggghts: str = field(default_factory=lambda: liggghts_build().executable)
     python: str = sys.executable
     openfoam_dir: str = field(
         default_factory=lambda: os.environ.get("WM_PROJECT_DIR", DEFAULT_OPENFOAM_DIR)
@@ -131,6 +132,11 @@ class LaunchProfile:
             self.env.setdefault("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
         # Single-threaded BLAS and OpenMP inside each rank: MPI ranks already fill the cores.
         self.env.setdefault("OMP_NUM_THREADS", "1")
+        build = liggghts_build()
+        if build.library is not None:
+            # The coupling loop loads LIGGGHTS as a library in its own processes
+            # (drumflow.coupling.library reads this variable).
+            self.env.setdefault(LIBRARY_VARIABLE, build.library)
 
     def mpi_command(self, program: Sequence[str], processes: int) -> list[str]:
         """Wrap a program in the MPI launcher.
@@ -170,10 +176,77 @@ class LaunchProfile:
             "python": sys.version.split()[0],
             "platform": platform.platform(),
             "liggghts": _dpkg_version("liggghts"),
+            "liggghts_build": liggghts_build().describe(),
             "openfoam": _dpkg_version("openfoam"),
             "openmpi": _dpkg_version("openmpi-bin"),
             "packages": packages,
         }
+
+
+#: Names a LIGGGHTS built from source (``PREFIX/bin/liggghts``, ``PREFIX/lib/libliggghts.so.3``,
+#: ``PREFIX/build-flags.txt``; ``scripts/install.sh --liggghts-native``); unset: the Debian package.
+PREFIX_VARIABLE = "DRUMFLOW_LIGGGHTS_PREFIX"
+#: The library the coupling loop loads (drumflow.coupling.library).
+LIBRARY_VARIABLE = "DRUMFLOW_LIGGGHTS_LIBRARY"
+#: The file of a build's prefix that records its compiler and flags.
+BUILD_FLAGS_FILE = "build-flags.txt"
+
+
+@dataclass(frozen=True)
+class LiggghtsBuild:
+    """Which LIGGGHTS runs: the Debian package (``prefix`` None) or a build from source.
+
+    Attributes
+    ----------
+    prefix
+        Install prefix of a build from source, or ``None`` for the Debian package.
+    executable
+        The ``liggghts`` program to launch.
+    library
+        The shared library for the coupling loop, or ``None`` for the system's
+        ``libliggghts.so.3``.
+    flags
+        The build's compiler and flags as its ``build-flags.txt`` records them (``None`` for the
+        Debian package: -O2, Debian's hardening, no -march).
+    """
+
+    prefix: str | None
+    executable: str
+    library: str | None
+    flags: str | None
+
+    def describe(self) -> dict[str, str | None]:
+        """For the manifest and the benchmarks' results files."""
+        if self.prefix is None:
+            return {"source": "debian package", "prefix": None, "flags": None}
+        return {"source": "built from source", "prefix": self.prefix, "flags": self.flags}
+
+
+def liggghts_build(prefix: str | None = None) -> LiggghtsBuild:
+    """The LIGGGHTS build at ``prefix``, or the one ``DRUMFLOW_LIGGGHTS_PREFIX`` names, or the
+    Debian package.
+
+    Raises
+    ------
+    SolverNotFoundError
+        ``prefix`` (or the variable) names a folder without ``bin/liggghts`` and
+        ``lib/libliggghts.so.3``: refused by name rather than silently running Debian's.
+    """
+    prefix = prefix if prefix is not None else (os.environ.get(PREFIX_VARIABLE) or None)
+    if prefix is None:
+        return LiggghtsBuild(None, "liggghts", None, None)
+    root = Path(prefix)
+    executable, library = root / "bin" / "liggghts", root / "lib" / "libliggghts.so.3"
+    missing = [str(p) for p in (executable, library) if not p.is_file()]
+    if missing:
+        raise SolverNotFoundError(
+            "liggghts", missing, None, None,
+            reason=f"{PREFIX_VARIABLE}={prefix}: not a LIGGGHTS build ({', '.join(missing)} missing); "
+            "build one with `bash scripts/install.sh --liggghts-native`, or unset "
+            f"{PREFIX_VARIABLE} for the Debian package")
+    flags_file = root / BUILD_FLAGS_FILE
+    flags = flags_file.read_text(errors="replace").strip() if flags_file.is_file() else None
+    return LiggghtsBuild(str(root), str(executable), str(library), flags)
 
 
 def _dpkg_version(package: str) -> str | None:

@@ -56,6 +56,7 @@ from drumflow.bench.settings_variants import (
     variant_steps,
 )
 from drumflow.case import Case, load_case
+from drumflow.coupling.interior import InteriorSpec
 from drumflow.coupling.spec import (
     COUPLING_FILE,
     CouplingSpec,
@@ -100,7 +101,8 @@ def bed_impact_speed(rundir: RunDir, restart_step: int, case: Case) -> tuple[flo
     return float(weighted_quantiles(sample.speed, sample.weight, [0.5])[0]), snap.step
 
 
-def _restart(rundir: RunDir, step: int | None) -> tuple[Path, int]:
+def restart_file(rundir: RunDir, step: int | None) -> tuple[Path, int]:
+    """The run's restart file at ``step`` (default: the newest) and its step."""
     if step is None:
         newest = latest_restart(rundir.dem_restart)
         if newest is None:
@@ -128,9 +130,16 @@ def baseline_deck(rundir: RunDir, restart_step: int, ranks: int, scratch: Path,
     # Rendered as the DEM stage renders a resume deck, in a scratch run directory.
     data = json.loads(rundir.geometry_json.read_text())
     geometry = GeometryResult(**{**data, "box_lo": tuple(data["box_lo"]), "box_hi": tuple(data["box_hi"])})
+    # Everything of the loop's input that changes the deck (regression: a run with shells was
+    # rendered without the deck's shell temperatures, and its loop stopped on a missing shellT).
+    interior = driver.get("interior")
     coupling = CouplingSpec(field=driver["field"], field_key="", interval=int(driver["interval"]),
                             temperature_C=float(driver["air_temperature_C"]),
-                            pressure_kPa=float(driver["air_pressure_kPa"]), omega=float(driver["omega"]))
+                            pressure_kPa=float(driver["air_pressure_kPa"]), omega=float(driver["omega"]),
+                            coarse_grain=float(driver.get("coarse_grain", 1.0)),
+                            heat_capacity=driver.get("heat_capacity"),
+                            interior=InteriorSpec.from_json(interior) if interior else None,
+                            warming=driver.get("warming"))
     inputs = DemInputs.for_case(case, geometry, coupling=coupling, processes=ranks)
     source = RunDir(scratch / "_deck")
     source.dem.mkdir(parents=True, exist_ok=True)
@@ -147,7 +156,7 @@ def variant_clock(deck: str, start_step: int, start_time: float) -> str:
                          f"variable sim_time equal {start_time:.12g}+(step-{start_step})*dt")
 
 
-def _prepare(folder: Path, rundir: RunDir, restart: Path, deck: str, driver: dict[str, Any],
+def prepare_variant(folder: Path, rundir: RunDir, restart: Path, deck: str, driver: dict[str, Any],
              end_step: int, time_step_factor: float = 1.0, start_step: int = 0,
              loop_heat: bool = False, overlap_every_row: bool = False) -> None:
     """A run-directory-like folder: case, geometry, the deck, the restart (linked, read only)
@@ -182,7 +191,7 @@ def _prepare(folder: Path, rundir: RunDir, restart: Path, deck: str, driver: dic
     (dem / COUPLING_FILE).write_text(json.dumps(spec, indent=2))
 
 
-def _measure(folder: Path, steps: int) -> dict[str, Any]:
+def measure_variant(folder: Path, steps: int) -> dict[str, Any]:
     """Timings, breakdown and end state of a finished variant."""
     profile = profile_run(folder, window_s=math.inf)
     window = profile.windows.iloc[0]
@@ -337,7 +346,7 @@ def run_settings_study(case: Case, run_dir: Path, out: Path, steps: int = 400, r
         raise SettingsStudyError(f"{driver_path}: missing; the study runs the coupling loop, so "
                                  "the run must have air (air.model 'uniform' or 'cfd')")
     driver = json.loads(driver_path.read_text())
-    restart, start = _restart(rundir, restart_step)
+    restart, start = restart_file(rundir, restart_step)
     scratch = out / "variants"
     scratch.mkdir(parents=True, exist_ok=True)
     deck, deck_source = baseline_deck(rundir, start, ranks, scratch, driver)
@@ -388,7 +397,7 @@ def run_settings_study(case: Case, run_dir: Path, out: Path, steps: int = 400, r
             folder = scratch / variant.name
             n_steps = variant_steps(steps, variant)
             edited = apply_variant(deck, variant, ranks, case.dem_case(), bed_speed)
-            _prepare(folder, rundir, restart, edited, driver, start + n_steps,
+            prepare_variant(folder, rundir, restart, edited, driver, start + n_steps,
                      variant.time_step_factor, start, variant.no_conduction,
                      overlap_every_row=variant.overlap_every_row or variant.no_overlap)
             t0 = time.perf_counter()
@@ -403,7 +412,7 @@ def run_settings_study(case: Case, run_dir: Path, out: Path, steps: int = 400, r
                 write()
                 continue
             row.update(status="ok", wall_s=record.wall_time_s or time.perf_counter() - t0,
-                       time_step_factor=variant.time_step_factor, **_measure(folder, n_steps))
+                       time_step_factor=variant.time_step_factor, **measure_variant(folder, n_steps))
         if base is None:
             base = row
         row.update(physics_check(row, base))

@@ -76,11 +76,25 @@ def bench(
     ranks: Annotated[
         int | None, typer.Option("--np", min=1, help="with --from: MPI ranks (default: the case's)")
     ] = None,
+    builds: Annotated[
+        str | None, typer.Option("--builds", help="with --from: LIGGGHTS builds side by side, "
+                                 "interleaved ('debian' or install prefixes, comma-separated)")
+    ] = None,
+    levels: Annotated[
+        bool, typer.Option("--levels", help="with --from: the run's physics levels side by side, "
+                           "interleaved (one-way lumped, shells, air that warms): their cost")
+    ] = False,
+    repeats: Annotated[
+        int, typer.Option("--repeats", min=1, max=20, help="with --builds or --levels: runs of each")
+    ] = 3,
 ) -> None:
     """Run time against error: a ladder of settings on one scene -> results.csv and pareto.png.
 
     With --from RUN_DIR: LIGGGHTS' settings (neighbour skin, rebuild rule, sorting, processor
-    grid, the conservative reference) side by side from one restart of that run -> settings.csv.
+    grid, the conservative reference) side by side from one restart of that run -> settings.csv;
+    with --builds as well: LIGGGHTS builds (the Debian package, a -O3 -march=native build)
+    interleaved A-B-A-B from that restart -> builds.csv and builds.json; with --levels: the
+    run's physics levels the same way -> levels.csv and levels.json.
     """
     from drumflow.readers import output_folder
 
@@ -91,8 +105,17 @@ def bench(
         if time_s is not None or speed_only:
             raise typer.BadParameter("--time and --speed-only are for the ladder from a fresh "
                                      "start, not with --from", param_hint="--from")
+        if builds is not None and levels:
+            raise typer.BadParameter("one comparison at a time: --builds or --levels",
+                                     param_hint="--levels")
+        if builds is not None or levels:
+            _bench_arms(case, from_run, out, builds, steps, restart, ranks, repeats, timeout)
+            return
         _bench_from_run(case, from_run, out, rungs, steps, restart, ranks, timeout, list_only)
         return
+    if builds is not None or levels:
+        raise typer.BadParameter("--builds and --levels run from a restart: give --from RUN_DIR",
+                                 param_hint="--builds" if builds is not None else "--levels")
     _bench_ladder(case, case_file, out, rungs, time_s, timeout, list_only, speed_only)
 
 
@@ -161,6 +184,34 @@ def _frame_table(title: str, frame: Any, cols: list[tuple[str, str, str]], clip:
             cells.append("" if v is None or (isinstance(v, float) and v != v) else fmt.format(v)[:clip])
         table.add_row(*cells)
     return table
+
+
+def _bench_arms(case: Any, run_dir: Path, out: Path | None, builds: str | None, steps: int,
+                restart: int | None, ranks: int | None, repeats: int, timeout: float | None) -> None:
+    from drumflow.bench.interleaved import run_arms, speedup_line
+
+    out = out or Path("runs") / "bench" / case.name / ("builds" if builds else "levels")
+    ranks = ranks or case.run.processes
+    t0 = time.monotonic()
+
+    def on_run(arm: str, repeat: int, index: int, total: int, row: dict[str, Any] | None) -> None:
+        elapsed = time.monotonic() - t0
+        if row is None:
+            err_console.print(f"[{index + 1}/{total}] {arm}, repeat {repeat + 1}: {steps} steps on "
+                              f"{ranks} rank(s)... (elapsed {elapsed / 60:.1f} min)", highlight=False)
+            return
+        eta = elapsed / (index + 1) * (total - index - 1)
+        busy = " [yellow](machine busy before it)[/]" if row["contended"] else ""
+        physics = {True: ", physics ok", False: ", physics CHANGED", None: ""}[row["physics_ok"]]
+        err_console.print(f"  {row['particle_steps_per_s']:,.0f} particle-steps/s{physics}{busy} "
+                          f"(ETA {eta / 60:.1f} min)", highlight=False)
+
+    result = run_arms(case, run_dir, out, builds=builds.split(",") if builds else None, steps=steps,
+                      ranks=ranks, repeats=repeats, restart_step=restart, timeout=timeout or 3600.0,
+                      on_run=on_run)
+    for name in result.summary:
+        console.print(speedup_line(result.summary, name), highlight=False)
+    console.print(f"written: {result.csv}, {result.json}", highlight=False)
 
 
 def _bench_from_run(case: Any, run_dir: Path, out: Path | None, rungs: str | None, steps: int,

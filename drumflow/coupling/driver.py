@@ -58,9 +58,15 @@ from drumflow.coupling.interior import (
     InteriorSpec,
     granule,
 )
-from drumflow.coupling.library import Liggghts
+from drumflow.coupling.library import Liggghts, loaded_library_path
 from drumflow.coupling.mpi import allreduce_sum
-from drumflow.coupling.spec import OVERLAP_OFF, OVERLAP_ON, STOP_REQUEST, STOPPED_RECORD
+from drumflow.coupling.spec import (
+    LIBRARY_RECORD,
+    OVERLAP_OFF,
+    OVERLAP_ON,
+    STOP_REQUEST,
+    STOPPED_RECORD,
+)
 from drumflow.coupling.stop import StopMonitor
 from drumflow.physics.drum_frame import drum_angle, rotate_to_drum_frame, rotate_to_lab_frame
 from drumflow.physics.particle_air import AirState, convective_heat, drag_force, ranz_marshall_h
@@ -277,6 +283,9 @@ def run(spec_path: Path) -> int:
     interval = int(spec["interval"])
     stride = profile_stride(interval, int(spec.get("profile_every_steps", PROFILE_EVERY_STEPS)))
     lmp = Liggghts(["-log", spec["log"], "-echo", "none"])
+    if rank == 0:
+        # Which LIGGGHTS build ran (Debian's or one built from source): benchmarks read it.
+        (work / LIBRARY_RECORD).write_text(f"{loaded_library_path()}\n")
     lmp.file(Path(spec["deck"]))
     # Time every fix on its own, so the breakdown splits LIGGGHTS' "Modify" share into walls,
     # conduction, air drag and integration (a clock read around each fix call: negligible

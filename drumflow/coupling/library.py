@@ -19,6 +19,20 @@ from drumflow.errors import SolverNotFoundError
 LIBRARY = os.environ.get("DRUMFLOW_LIGGGHTS_LIBRARY", "libliggghts.so.3")
 
 
+def loaded_library_path() -> str | None:
+    """The file of the LIGGGHTS library this process has mapped (from ``/proc/self/maps``), or
+    ``None``: which build really ran, whatever the variables said (a benchmark records it)."""
+    try:
+        maps = Path("/proc/self/maps").read_text()
+    except OSError:
+        return None
+    for line in maps.splitlines():
+        parts = line.split(maxsplit=5)
+        if len(parts) == 6 and "libliggghts" in Path(parts[5]).name:
+            return parts[5].strip()
+    return None
+
+
 class Liggghts:
     """One LIGGGHTS instance in this process (or, under mpirun, on MPI_COMM_WORLD).
 

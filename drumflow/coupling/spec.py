@@ -41,6 +41,9 @@ STOP_REQUEST = "stop.request"
 #: What the loop leaves in its place once it has written that restart: ``{"step", "time_s"}``.
 #: Its presence tells the DEM stage that the loop ended on request, not at the end of the run.
 STOPPED_RECORD = "stopped.json"
+#: The LIGGGHTS library the loop loaded (``/proc/self/maps`` of rank 0), in the DEM working
+#: directory: which build ran.
+LIBRARY_RECORD = "liggghts_library.txt"
 #: Where each rank of the loop writes its log, relative to the DEM working directory.
 COUPLING_LOG_PATTERN = "coupling/rank{rank}.{start}.csv"
 #: The deck's thermo column ``v_overlap`` (drumflow.dem.thermo) on the rows the loop leaves the

@@ -107,8 +107,16 @@ class StartState:
 
 def scene_hash(case: Case) -> str:
     """Hash of what the particles must fit: the drum, lifters and particles sections of what
-    the DEM moves (the parcels of a coarse-grained case, :meth:`Case.dem_case`)."""
-    return case.dem_case().section_hash(*SCENE_SECTIONS)
+    the DEM moves (the parcels of a coarse-grained case, :meth:`Case.dem_case`).
+
+    How a granule's inside is modelled (``particles.interior``, ``interior_shells``) is no part
+    of where the particles are: a state of a run with shells starts a lumped run, and the
+    paper's levels start from one another's beds. The state carries each particle's mean
+    temperature, which both levels take.
+    """
+    dem = case.dem_case()
+    particles = dem.particles.model_copy(update={"interior": "lumped", "interior_shells": None})
+    return dem.model_copy(update={"particles": particles}).section_hash(*SCENE_SECTIONS)
 
 
 def state_from_snapshot(snap: Snapshot, case: Case, time_step: float, source: str = "") -> StartState:

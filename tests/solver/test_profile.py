@@ -173,3 +173,97 @@ def test_settings_study_refuses_another_scene(run: Path, tmp_path: Path) -> None
     assert "another scene" in proc.stderr and "particles" in proc.stderr
     assert "Traceback" not in proc.stderr
     assert not (tmp_path / "study" / "variants").exists()
+
+
+def _copied_build(root: Path) -> Path:
+    """A 'build from source' that is a copy of the Debian package's library, under another
+    path: the comparison's machinery on the real solver without compiling LIGGGHTS."""
+    import ctypes.util
+    import os
+    import shutil
+
+    found = next((p for p in ("/usr/lib/x86_64-linux-gnu/libliggghts.so.3",
+                              ctypes.util.find_library("liggghts") or "") if p and os.path.isfile(p)), None)
+    assert found is not None, "the Debian package's libliggghts.so.3 (apt libliggghts3)"
+    (root / "lib").mkdir(parents=True)
+    (root / "bin").mkdir()
+    shutil.copy2(found, root / "lib" / "libliggghts.so.3")
+    liggghts = shutil.which("liggghts")
+    assert liggghts is not None
+    (root / "bin" / "liggghts").symlink_to(liggghts)
+    (root / "build-flags.txt").write_text("a copy of the Debian package's library (test)\n")
+    return root
+
+
+def test_builds_side_by_side_interleaved(run: Path, tmp_path: Path) -> None:
+    # Two builds, two repeats: the runs alternate A-B-A-B, each loaded the library it was given
+    # (read back from the loop's own /proc/self/maps), and the same library gives the same
+    # end state to the last digit on one rank, so the physics check passes with no slack used.
+    copy = _copied_build(tmp_path / "copy")
+    study = tmp_path / "builds"
+    proc = _bench_from(run, run / "case.toml", study, "--builds", f"debian,{copy}", "--repeats", "2")
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    table = pd.read_csv(study / "builds.csv")
+    assert list(table["arm"]) == ["debian", str(copy), "debian", str(copy)]
+    assert list(table["repeat"]) == [0, 0, 1, 1]
+    assert table["library_ok"].all(), table[["arm", "library"]]
+    assert table.loc[table["arm"] == str(copy), "library"].eq(str(copy / "lib" / "libliggghts.so.3")).all()
+    assert not table.loc[table["arm"] == "debian", "library"].str.startswith(str(copy)).any()
+    assert (table["steps"] == 100).all() and (table["particle_steps_per_s"] > 0).all()
+    assert table["T_end_C"].nunique() == 1 and table["kinetic_energy_J"].nunique() == 1
+    meta = json.loads((study / "builds.json").read_text())
+    assert meta["arms"][str(copy)]["build"]["flags"].startswith("a copy of the Debian")
+    assert meta["arms"]["debian"]["build"]["source"] == "debian package"
+    assert table["physics_ok"].all()
+    speedup = meta["summary"][str(copy)]["speedup_vs_first"]
+    assert speedup["min"] <= speedup["median"] <= speedup["max"] and speedup["median"] > 0
+    assert f"{str(copy)}: " in proc.stdout and "x the first arm's speed" in proc.stdout
+
+
+def test_builds_refused_by_name_before_any_run(run: Path, tmp_path: Path) -> None:
+    # A prefix that is not a build, and a single build: exit 2, one message, nothing run.
+    empty = tmp_path / "not-a-build"
+    empty.mkdir()
+    proc = _bench_from(run, run / "case.toml", tmp_path / "b1", "--builds", f"debian,{empty}")
+    assert proc.returncode == 2, proc.stderr
+    assert str(empty / "lib" / "libliggghts.so.3") in proc.stderr and "Traceback" not in proc.stderr
+    assert not (tmp_path / "b1" / "runs").exists()
+    proc = _bench_from(run, run / "case.toml", tmp_path / "b2", "--builds", "debian")
+    assert proc.returncode == 2 and "two or more different builds" in proc.stderr, proc.stderr
+
+
+def test_levels_side_by_side_interleaved(tmp_path: Path) -> None:
+    # The cost of the physics levels (issue 31): from one restart of a run with shells and air
+    # that warms, the loop runs at each level in turn, A-B-C-A-B-C; each level's parts reach
+    # the loop's input or are left out of it, and each level logs what it runs (the interior
+    # log for shells, the air's temperature for warming).
+    from drumflow.pipeline import run_case
+    from drumflow.verify.scenes import tiny_drum
+
+    case = tiny_drum(air__model="uniform", air__mass_flow=0.1, air__warming=True,
+                     particles__interior="shells", run__time=0.2, run__mass_flow_start=0.1,
+                     run__restart_interval=0.1, run__processes=1)
+    run = tmp_path / "run"
+    run_case(case, run, timeout=300)
+    study = tmp_path / "levels"
+    proc = _bench_from(run, run / "case.toml", study, "--levels", "--repeats", "2")
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    table = pd.read_csv(study / "levels.csv")
+    names = ["one-way lumped", "shells", "shells + warming"]
+    assert list(table["arm"]) == names * 2 and list(table["repeat"]) == [0, 0, 0, 1, 1, 1]
+    assert table["physics_ok"].isna().all()  # levels change the physics on purpose
+    runs = sorted((study / "runs").iterdir())
+    specs = [json.loads((r / "dem" / "coupling.json").read_text()) for r in runs[:3]]
+    assert ["interior" in s for s in specs] == [False, True, True]
+    assert ["warming" in s for s in specs] == [False, False, True]
+    assert not list((runs[0] / "dem" / "coupling").glob("interior_rank*"))
+    assert list((runs[1] / "dem" / "coupling").glob("interior_rank*"))
+    # The same level gives the same end state in both repeats (one rank, same input) and the
+    # levels differ from one another (shells cool the mean more slowly at Bi > 0.1).
+    t_end = table.groupby("arm")["T_end_C"]
+    assert (t_end.nunique() == 1).all()
+    assert t_end.first()["shells"] != t_end.first()["one-way lumped"]
+    meta = json.loads((study / "levels.json").read_text())
+    assert meta["kind"] == "levels" and meta["arms"]["one-way lumped"]["left_out_of_the_loop"] == [
+        "interior", "warming"]
+    assert "cost" in proc.stdout

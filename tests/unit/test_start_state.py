@@ -195,3 +195,40 @@ def test_a_state_of_another_scene_is_refused_before_any_stage(tmp_path: Path) ->
     assert out.returncode == 2, out.stdout + out.stderr
     assert "run.start_state" in out.stdout + out.stderr
     assert not (tmp_path / "run").exists()  # nothing left behind
+
+
+#: The paper scenes' parcel states (issue 35, item 2): the bed settled (2 s) and cascading (5 s),
+#: from the level runs of results/paper/levels (coarse grain 2), each against the case it fits.
+PAPER_STATES = {
+    "paper_model_one_cg2_2.0s.npz": ("paper_model_one_shells_cg2", 58_430, 2.009),
+    "paper_model_one_cg2_5.0s.npz": ("paper_model_one_shells_cg2", 58_430, 5.002),
+    "paper_model_two_cg2_5.0s.npz": ("paper_model_two_lumped_cg2", 37_396, 5.009),
+}
+
+
+@pytest.mark.parametrize("name", sorted(PAPER_STATES))
+def test_shipped_paper_states_fit_their_cases(name: str) -> None:
+    run, count, time_s = PAPER_STATES[name]
+    path = ROOT / "results" / "states" / name
+    state = read_state(path)
+    check_state(state, load_case(ROOT / "results" / "paper" / "levels" / "runs" / run / "case.toml"), name)
+    assert len(state) == count and state.time_s == pytest.approx(time_s, abs=1e-3)
+    assert path.stat().st_size < 4_000_000  # compact enough for git (~42-52 bytes per parcel)
+    # Cascading at 5 s: curtains fall from the top of the 3 m drum (free fall from 1.3 m or more
+    # gives 5 m/s); at 2 s the bed still rides up with the drum (its wall moves at 0.79 m/s).
+    fastest = float(np.linalg.norm(state.velocities, axis=1).max())
+    assert fastest > 5.0 if time_s > 4 else fastest < 5.0
+
+
+def test_a_state_of_a_shells_run_starts_a_lumped_run() -> None:
+    # particles.interior is how a granule's inside is modelled, not where it is (regression:
+    # the model-two state of a shells run was refused by the lumped case of the same scene).
+    from drumflow.dem.state import scene_hash
+
+    runs = ROOT / "results" / "paper" / "levels" / "runs"
+    shells = load_case(runs / "paper_model_two_shells_cg2" / "case.toml")
+    lumped = load_case(runs / "paper_model_two_lumped_cg2" / "case.toml")
+    assert shells.particles.interior == "shells" and lumped.particles.interior == "lumped"
+    assert scene_hash(shells) == scene_hash(lumped)
+    bigger = lumped.model_copy(update={"particles": lumped.particles.model_copy(update={"diameter": 0.021})})
+    assert scene_hash(bigger) != scene_hash(lumped)
