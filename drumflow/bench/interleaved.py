@@ -14,8 +14,11 @@ the library the loop really loaded) and the ``.json`` beside it (per arm the med
 the ratio to the first arm as the median of the per-repeat ratios with their range, the
 machine, each build's flags).
 
-A run whose one-minute load average before it was above :data:`BUSY_LOAD` per rank is marked
-``contended``: its time is kept, and the summary counts them.
+Contention is measured, not guessed from the load average (which a run's own ranks keep up for a
+minute after it): the machine's busy CPU time over the run (``/proc/stat``) less the CPU time of
+the run's own processes (``getrusage`` of the waited-for children) is the CPU that other programs
+took meanwhile; a run where they took more than :data:`BUSY_OTHER_CORES` of a core on average is
+marked ``contended``. Its time is kept, and the summary counts them.
 
 Physics check (builds only: levels change the physics on purpose): a build with other flags
 changes round-off (-march=native contracts a*b+c into fused multiply-adds), which a granular bed
@@ -26,7 +29,9 @@ amplifies; the end state is held to the settings study's tolerances
 from __future__ import annotations
 
 import json
+import math
 import os
+import resource
 import statistics
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -51,12 +56,12 @@ from drumflow.errors import SettingsStudyError, SolverNotFoundError
 from drumflow.rundir import RunDir
 from drumflow.runner import LIBRARY_VARIABLE, LaunchProfile, LiggghtsBuild, Runner, liggghts_build
 
-__all__ = ["BUSY_LOAD", "DEBIAN", "Arm", "Comparison", "build_arms", "level_arms", "run_arms"]
+__all__ = ["BUSY_OTHER_CORES", "DEBIAN", "Arm", "Comparison", "build_arms", "level_arms", "run_arms"]
 
 #: The name that means the Debian package's LIGGGHTS.
 DEBIAN = "debian"
-#: One-minute load average per MPI rank above which a run is marked contended.
-BUSY_LOAD = 0.5
+#: Other programs' mean CPU use during a run, in cores, above which the run is marked contended.
+BUSY_OTHER_CORES = 0.1
 _DEBIAN_BUILD = LiggghtsBuild(None, "liggghts", None, None)
 #: The coupling loop's inputs of each physics level above the paper's (drumflow.coupling.spec).
 _INTERIOR, _WARMING = "interior", "warming"
@@ -181,6 +186,22 @@ def library_matches(used: str | None, build: LiggghtsBuild, others: Sequence[Lig
     return all(o.library is None or real != os.path.realpath(o.library) for o in others)
 
 
+def machine_busy_cpu_s() -> float:
+    """CPU seconds the whole machine has been busy since boot (``/proc/stat``; NaN elsewhere)."""
+    try:
+        fields = Path("/proc/stat").read_text().split("\n", 1)[0].split()
+    except OSError:
+        return math.nan
+    user, nice, system, _idle, _iowait, irq, softirq, steal = (int(v) for v in fields[1:9])
+    return (user + nice + system + irq + softirq + steal) / os.sysconf("SC_CLK_TCK")
+
+
+def children_cpu_s() -> float:
+    """CPU seconds of this process's waited-for descendants (the runs' mpirun and its ranks)."""
+    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return usage.ru_utime + usage.ru_stime
+
+
 def _stats(values: list[float]) -> dict[str, float]:
     return {"median": statistics.median(values), "min": min(values), "max": max(values)}
 
@@ -191,6 +212,9 @@ def summarise(table: pd.DataFrame, names: Sequence[str]) -> dict[str, Any]:
     faster than the first arm."""
     ok = table[table["status"] == "ok"]
     base = ok[ok["arm"] == names[0]].set_index("repeat")["coupled_wall_s"]
+    first = ok[ok["arm"] == names[0]]
+    base_loop = statistics.median(first["python_wall_s"].astype(float)) if len(first) else math.nan
+    base_wall = statistics.median(first["coupled_wall_s"].astype(float)) if len(first) else math.nan
     out: dict[str, Any] = {}
     for name in names:
         rows = ok[ok["arm"] == name]
@@ -204,6 +228,16 @@ def summarise(table: pd.DataFrame, names: Sequence[str]) -> dict[str, Any]:
             "runs": len(rows), "contended_runs": int(rows["contended"].sum()),
             "coupled_wall_s": _stats(rows["coupled_wall_s"].astype(float).tolist()),
             "particle_steps_per_s": _stats(rows["particle_steps_per_s"].astype(float).tolist()),
+            # The loop's own work (air, drag, heat, shells, the air's temperature) and LIGGGHTS':
+            # a physics level adds to the first, a build changes the second.
+            "python_wall_s": _stats(rows["python_wall_s"].astype(float).tolist()),
+            "liggghts_wall_s": _stats(rows["liggghts_wall_s"].astype(float).tolist()),
+            # Levels run the same deck, so LIGGGHTS' work is the same in every arm and its run-to-
+            # run noise (several per cent) is no part of a level's cost: the level adds loop time
+            # only. Its cost against the first arm is then 1 + (extra loop time) / (first arm's
+            # wall time), medians; for builds it means nothing (they change LIGGGHTS' time).
+            "loop_cost_vs_first": 1.0 + (statistics.median(rows["python_wall_s"].astype(float))
+                                         - base_loop) / base_wall,
             "speedup_vs_first": _stats(ratios) if ratios else None,
             "physics_ok": bool(checked.astype(bool).all()) if len(checked) else None,
             "library_ok": bool(rows["library_ok"].all()),
@@ -269,7 +303,7 @@ def run_arms(case: Case, run_dir: Path, out: Path, arms: Sequence[Arm] | None = 
         "kind": kind, "run_dir": str(rundir.root.resolve()), "restart": str(restart),
         "restart_step": start, "steps": steps, "ranks": ranks, "repeats": repeats,
         "deck": deck_source, "order": "interleaved: each repeat runs every arm once, in the order given",
-        "busy_load_per_rank": BUSY_LOAD,
+        "busy_other_cores": BUSY_OTHER_CORES,
         "arms": {a.name: {"description": a.description, "build": a.build.describe(),
                           "left_out_of_the_loop": list(a.drop)} for a in chosen},
         "machine": machine_info(Runner(), ranks),
@@ -298,13 +332,16 @@ def run_arms(case: Case, run_dir: Path, out: Path, arms: Sequence[Arm] | None = 
             folder = scratch / f"{repeat}_{position}"
             spec = {k: v for k, v in driver.items() if k not in arm.drop}
             prepare_variant(folder, rundir, restart, deck, spec, start + steps, 1.0, start)
-            load = os.getloadavg()[0]
+            busy0, own0 = machine_busy_cpu_s(), children_cpu_s()
             runner = Runner(_profile_for(arm.build))
             record = runner.run("liggghts", driver_command(runner.profile, ranks, COUPLING_FILE),
                                 folder / "dem", folder / "dem" / "liggghts.out", timeout=timeout,
                                 check=finished_loop, follow=folder / "dem" / "log.liggghts")
+            own = children_cpu_s() - own0
+            other = max(0.0, machine_busy_cpu_s() - busy0 - own) / max(record.wall_time_s, 1e-9)
             row: dict[str, Any] = {"arm": arm.name, "repeat": repeat, "status": "ok",
-                                   "load_before": load, "contended": load > BUSY_LOAD * ranks,
+                                   "run_cpu_s": own, "other_programs_cores": other,
+                                   "contended": bool(other > BUSY_OTHER_CORES),
                                    "wall_s": record.wall_time_s, **measure_variant(folder, steps),
                                    # What really ran, from the loop's own process maps.
                                    "library": _library_used(folder)}
@@ -323,10 +360,16 @@ def run_arms(case: Case, run_dir: Path, out: Path, arms: Sequence[Arm] | None = 
     return Comparison(table=table, summary=summarise(table, names), csv=csv_path, json=json_path)
 
 
-def speedup_line(summary: dict[str, Any], name: str) -> str:
-    """One line for the CLI: the arm's speed against the first arm's, median and range."""
-    stats = summary.get(name, {}).get("speedup_vs_first")
+def speedup_line(summary: dict[str, Any], name: str, levels: bool = False) -> str:
+    """One line for the CLI: the arm's speed against the first arm's, median and range; for a
+    level, first its cost from the loop's extra time (:func:`summarise`)."""
+    entry = summary.get(name, {})
+    stats = entry.get("speedup_vs_first")
     if not stats:
         return f"{name}: no run"
-    return (f"{name}: {stats['median']:.3f} x the first arm's speed (range {stats['min']:.3f}-"
-            f"{stats['max']:.3f} over the repeats; cost {1 / stats['median']:.3f} x)")
+    ratio = (f"{stats['median']:.3f} x the first arm's speed (range {stats['min']:.3f}-"
+             f"{stats['max']:.3f} over the repeats)")
+    if levels:
+        return (f"{name}: cost {entry['loop_cost_vs_first']:.3f} x the first arm's from its extra loop "
+                f"time; wall time: {ratio}")
+    return f"{name}: {ratio}"

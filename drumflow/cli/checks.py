@@ -201,7 +201,8 @@ def _bench_arms(case: Any, run_dir: Path, out: Path | None, builds: str | None, 
                               f"{ranks} rank(s)... (elapsed {elapsed / 60:.1f} min)", highlight=False)
             return
         eta = elapsed / (index + 1) * (total - index - 1)
-        busy = " [yellow](machine busy before it)[/]" if row["contended"] else ""
+        busy = (f" [yellow](other programs took {row['other_programs_cores']:.2f} cores)[/]"
+                if row["contended"] else "")
         physics = {True: ", physics ok", False: ", physics CHANGED", None: ""}[row["physics_ok"]]
         err_console.print(f"  {row['particle_steps_per_s']:,.0f} particle-steps/s{physics}{busy} "
                           f"(ETA {eta / 60:.1f} min)", highlight=False)
@@ -210,7 +211,7 @@ def _bench_arms(case: Any, run_dir: Path, out: Path | None, builds: str | None, 
                       ranks=ranks, repeats=repeats, restart_step=restart, timeout=timeout or 3600.0,
                       on_run=on_run)
     for name in result.summary:
-        console.print(speedup_line(result.summary, name), highlight=False)
+        console.print(speedup_line(result.summary, name, levels=builds is None), highlight=False)
     console.print(f"written: {result.csv}, {result.json}", highlight=False)
 
 

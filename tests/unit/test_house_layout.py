@@ -8,9 +8,9 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
 
-#: What a user runs to install, start and test, and the cluster start-up; everything else that
-#: is run by hand once is a study (studies/).
-SCRIPTS = {"install.sh", "quickstart.sh", "test.sh", "slurm_localhost.sh"}
+#: What a user runs to install, start and test, the cluster start-up and the optional LIGGGHTS
+#: build from source; everything else that is run by hand once is a study (studies/).
+SCRIPTS = {"install.sh", "quickstart.sh", "test.sh", "slurm_localhost.sh", "build_liggghts.sh"}
 
 #: A module a newcomer reads in one sitting.
 MAX_MODULE_LINES = 600

@@ -95,6 +95,7 @@ def test_summary_is_the_median_of_neighbouring_ratios() -> None:
         for arm, wall in (("debian", wall_a), ("/opt/x", wall_b)):
             rows.append({"arm": arm, "repeat": repeat, "status": "ok", "coupled_wall_s": wall,
                          "particle_steps_per_s": 1000.0 / wall, "contended": repeat == 1,
+                         "python_wall_s": 0.1 * wall, "liggghts_wall_s": 0.9 * wall,
                          "physics_ok": True, "library_ok": True})
     summary = summarise(pd.DataFrame(rows), ["debian", "/opt/x"])
     b = summary["/opt/x"]
@@ -103,6 +104,8 @@ def test_summary_is_the_median_of_neighbouring_ratios() -> None:
     assert summary["debian"]["coupled_wall_s"]["median"] == 12.0
     assert summary["debian"]["speedup_vs_first"]["median"] == 1.0
     assert b["contended_runs"] == 1 and b["runs"] == 3 and b["physics_ok"] and b["library_ok"]
+    # The loop's extra time over the first arm's wall: medians 0.6 and 1.2 s of loop, 12 s of wall.
+    assert b["loop_cost_vs_first"] == pytest.approx(1.0 + (0.6 - 1.2) / 12.0, rel=1e-12)
     # A ratio of medians would say 12 / 6 = 2 as well here; with an outlier repeat it would not:
     rows[3]["coupled_wall_s"] = 60.0  # repeat 1 of /opt/x on a much slower stretch
     b = summarise(pd.DataFrame(rows), ["debian", "/opt/x"])["/opt/x"]
@@ -125,3 +128,20 @@ def test_builds_describe_their_flags(tmp_path: Path) -> None:
     arms = build_arms(["debian", str(_fake_build(tmp_path / "n", flags="g++ 12 -O3\nmore"))])
     assert arms[0].description.startswith("the Debian package")
     assert arms[1].description == "g++ 12 -O3" and arms[1].same_physics and arms[1].drop == ()
+
+
+def test_contention_is_the_cpu_of_other_programs() -> None:
+    # A child that spins for 0.4 s of CPU: its time is counted as the run's own (rusage of the
+    # waited-for child), and the machine's busy time grew by at least as much.
+    import subprocess
+    import sys
+
+    from drumflow.bench.interleaved import children_cpu_s, machine_busy_cpu_s
+
+    busy0, own0 = machine_busy_cpu_s(), children_cpu_s()
+    subprocess.run([sys.executable, "-c", "import time\nt = time.process_time()\n"
+                    "while time.process_time() - t < 0.4: pass"], check=True)
+    own = children_cpu_s() - own0
+    assert 0.4 <= own < 2.0
+    # /proc/stat counts in clock ticks (1/100 s): the machine was busy at least the child's time.
+    assert machine_busy_cpu_s() - busy0 >= own - 0.05
