@@ -30,6 +30,7 @@ from pathlib import Path
 from typing import IO, TYPE_CHECKING, Any
 
 from drumflow.errors import SolverError, SolverNotFoundError, SolverTimeoutError
+from drumflow.machine_load import LoadLog
 
 if TYPE_CHECKING:
     from drumflow.case import Case
@@ -308,6 +309,7 @@ class Runner:
         follow: Path | None = None,
         stop_request: Path | None = None,
         stop_grace: float = STOP_GRACE_S,
+        load_log: Path | None = None,
     ) -> RunRecord:
         """Run ``command`` in ``cwd``, writing all it prints to ``log``.
 
@@ -341,6 +343,10 @@ class Runner:
             the start of its attempt.
         stop_grace
             Seconds allowed for that clean stop.
+        load_log
+            A CSV that receives the machine's load while the program runs
+            (:class:`drumflow.machine_load.LoadLog`: other programs' CPU, every 30 s; appended
+            to by a resumed attempt), so that a wall time says whether it had the machine.
 
         Raises
         ------
@@ -382,6 +388,9 @@ class Runner:
                 record.status = "interrupted"
                 record.wall_time_s = time.time() - record.started
                 raise
+            # The program's own session (start_new_session): the launcher and its MPI ranks,
+            # whose CPU the log tells apart from everything else's.
+            sampler = LoadLog(load_log, proc.pid) if load_log is not None else None
             try:
                 _wait(proc, watch, record.started, timeout)
             except subprocess.TimeoutExpired:
@@ -403,6 +412,9 @@ class Runner:
                 finally:
                     watch.halt(record, "interrupted")
                 raise
+            finally:
+                if sampler is not None:
+                    sampler.close()
             watch.finish()
             if watch.stops:
                 # The monitor's verdict (also on the last lines) outranks how the program ended.

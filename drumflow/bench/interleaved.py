@@ -53,6 +53,7 @@ from drumflow.case import Case
 from drumflow.coupling.spec import COUPLING_FILE, LIBRARY_RECORD, driver_command
 from drumflow.dem.stage import finished_loop
 from drumflow.errors import SettingsStudyError, SolverNotFoundError
+from drumflow.machine_load import machine_busy_cpu_s
 from drumflow.rundir import RunDir
 from drumflow.runner import LIBRARY_VARIABLE, LaunchProfile, LiggghtsBuild, Runner, liggghts_build
 
@@ -184,16 +185,6 @@ def library_matches(used: str | None, build: LiggghtsBuild, others: Sequence[Lig
     if build.library is not None:
         return real == os.path.realpath(build.library)
     return all(o.library is None or real != os.path.realpath(o.library) for o in others)
-
-
-def machine_busy_cpu_s() -> float:
-    """CPU seconds the whole machine has been busy since boot (``/proc/stat``; NaN elsewhere)."""
-    try:
-        fields = Path("/proc/stat").read_text().split("\n", 1)[0].split()
-    except OSError:
-        return math.nan
-    user, nice, system, _idle, _iowait, irq, softirq, steal = (int(v) for v in fields[1:9])
-    return (user + nice + system + irq + softirq + steal) / os.sysconf("SC_CLK_TCK")
 
 
 def children_cpu_s() -> float:

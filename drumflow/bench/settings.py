@@ -45,6 +45,7 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pandas as pd
 
 from drumflow.bench.profile import profile_run
@@ -282,7 +283,32 @@ def check_scene(case: Case, rundir: RunDir) -> None:
             f"({rundir.case_toml}) or another run directory")
 
 
-def _earlier_rows(out: Path, meta: dict[str, Any]) -> dict[str, dict[str, Any]]:
+def _plain(value: Any) -> Any:
+    """A JSON value that reads back as the same float (NaN and infinities as null)."""
+    if isinstance(value, np.generic):
+        value = value.item()
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    return value
+
+
+def write_study(rows: list[dict[str, Any]], meta: dict[str, Any], csv_path: Path,
+                json_path: Path) -> pd.DataFrame:
+    """Write the table (CSV, 6 digits) and its JSON (every float exact) and return the table.
+
+    The JSON holds the rows a resumed study keeps, so its floats are written in full: rounded
+    there (pandas' ``to_json`` keeps 10 digits), a kept row's CSV value could round differently
+    the second time (0.05116254999 -> 0.0511625500 -> 0.0511626) and the resumed table would
+    not be the one measured.
+    """
+    table = pd.DataFrame(rows)
+    table.to_csv(csv_path, index=False, float_format="%.6g")
+    records = [{key: _plain(value) for key, value in row.items()} for row in rows]
+    json_path.write_text(json.dumps({**meta, "results": records}, indent=2))
+    return table
+
+
+def earlier_rows(out: Path, meta: dict[str, Any]) -> dict[str, dict[str, Any]]:
     """Measured rows of an interrupted study with the same restart, steps and ranks."""
     json_path = out / TABLE.replace(".csv", ".json")
     try:
@@ -353,7 +379,7 @@ def run_settings_study(case: Case, run_dir: Path, out: Path, steps: int = 400, r
     variants = [v for v in VARIANTS if v.name == "baseline" or only is None or v.name in only]
     meta: dict[str, Any] = {"run_dir": str(rundir.root.resolve()), "restart": str(restart),
                             "restart_step": start, "steps": steps, "ranks": ranks}
-    earlier = _earlier_rows(out, meta)
+    earlier = earlier_rows(out, meta)
     bed_speed = None
     if any(v.bed_restitution for v in variants):
         bed_speed, snapshot_step = bed_impact_speed(rundir, start, case.dem_case())
@@ -372,12 +398,7 @@ def run_settings_study(case: Case, run_dir: Path, out: Path, steps: int = 400, r
 
     def write() -> pd.DataFrame:
         # After every variant, so an interrupted study keeps what it measured.
-        table = pd.DataFrame(rows)
-        table.to_csv(csv_path, index=False, float_format="%.6g")
-        json_path.write_text(json.dumps({**meta, "resumed": resumed,
-                                         "results": json.loads(table.to_json(orient="records"))},
-                                        indent=2))
-        return table
+        return write_study(rows, {**meta, "resumed": resumed}, csv_path, json_path)
 
     for index, variant in enumerate(variants):
         row: dict[str, Any] = {"variant": variant.name, "description": variant.description}

@@ -83,6 +83,9 @@ __all__ = ["DemInputs", "DemResult", "ProgressCallback", "clear_stop_request", "
 ProgressCallback = Callable[[str, float, float], None]
 
 _LOST_RE = re.compile(r"Lost atoms")
+#: The machine's load while the DEM ran (drumflow.machine_load), beside its log: every
+#: attempt of a resumed run appends to it.
+LOAD_LOG = "machine_load.csv"
 
 
 @dataclass(frozen=True)
@@ -475,7 +478,8 @@ def _launch(case: Case, rundir: RunDir, runner: Runner, inputs: DemInputs, deck_
     t0 = time.perf_counter()
     try:
         runner.run("liggghts", command, work, log, timeout=inputs.timeout, on_line=watcher,
-                   check=finished_loop, follow=own_log, stop_request=stop_request)
+                   check=finished_loop, follow=own_log, stop_request=stop_request,
+                   load_log=work / LOAD_LOG)
         if stopped_record.exists():
             # `drumflow stop`: the loop wrote a restart and ended before the run's end; the
             # manifest says so rather than "ok".

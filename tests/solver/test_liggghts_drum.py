@@ -17,9 +17,10 @@ from support.solvers import LIGGGHTS, requires_solver, tiny_case_dict
 from drumflow import dem
 from drumflow.case import case_from_dict, load_case
 from drumflow.dem.dumps import read_series
-from drumflow.dem.stage import DemInputs
+from drumflow.dem.stage import LOAD_LOG, DemInputs
 from drumflow.errors import LostParticlesError, RunDirectoryError, SolverTimeoutError
 from drumflow.geometry import build_geometry
+from drumflow.machine_load import read_load_log
 from drumflow.pipeline import post_run, run_case
 from drumflow.rundir import RunDir
 from drumflow.runner import Runner
@@ -207,6 +208,9 @@ def test_interrupted_run_resumes(tmp_path: Path) -> None:
     # Every snapshot packed once LIGGGHTS finished.
     dumps = out / "dem" / "dumps"
     assert not list(dumps.glob("snap.*.txt")) and len(list(dumps.glob("snap.*.npz"))) == len(snaps.steps)
+    # The machine's load beside the DEM log, both attempts in it: the run's ranks took CPU.
+    load = read_load_log(out / "dem" / LOAD_LOG)
+    assert len(load) >= 2 and (load["run_cores"] > 0.2).all(), load
 
 
 @pytest.mark.timeout(300)

@@ -136,7 +136,8 @@ def test_contention_is_the_cpu_of_other_programs() -> None:
     import subprocess
     import sys
 
-    from drumflow.bench.interleaved import children_cpu_s, machine_busy_cpu_s
+    from drumflow.bench.interleaved import children_cpu_s
+    from drumflow.machine_load import machine_busy_cpu_s
 
     busy0, own0 = machine_busy_cpu_s(), children_cpu_s()
     subprocess.run([sys.executable, "-c", "import time\nt = time.process_time()\n"
