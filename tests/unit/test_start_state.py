@@ -197,23 +197,28 @@ def test_a_state_of_another_scene_is_refused_before_any_stage(tmp_path: Path) ->
     assert not (tmp_path / "run").exists()  # nothing left behind
 
 
-#: The paper scenes' parcel states (issue 35, item 2): the bed settled (2 s) and cascading (5 s),
-#: from the level runs of results/paper/levels (coarse grain 2), each against the case it fits.
+#: The paper scenes' states (issue 35, item 2): the bed settled (2 s) and cascading (5 s); the
+#: parcel states (coarse grain 2) from the level runs of results/paper/levels, model two's with
+#: every particle from the rerun of its case that gave its closures (results/paper/README.md),
+#: each against the case it fits, with its size limit (~42-52 bytes per particle).
+LEVELS = Path("results") / "paper" / "levels" / "runs"
 PAPER_STATES = {
-    "paper_model_one_cg2_2.0s.npz": ("paper_model_one_shells_cg2", 58_430, 2.009),
-    "paper_model_one_cg2_5.0s.npz": ("paper_model_one_shells_cg2", 58_430, 5.002),
-    "paper_model_two_cg2_5.0s.npz": ("paper_model_two_lumped_cg2", 37_396, 5.009),
+    "paper_model_one_cg2_2.0s.npz": (LEVELS / "paper_model_one_shells_cg2" / "case.toml", 58_430, 2.009, 4e6),
+    "paper_model_one_cg2_5.0s.npz": (LEVELS / "paper_model_one_shells_cg2" / "case.toml", 58_430, 5.002, 4e6),
+    "paper_model_two_cg2_5.0s.npz": (LEVELS / "paper_model_two_lumped_cg2" / "case.toml", 37_396, 5.009, 4e6),
+    "paper_model_two_2.0s.npz": (Path("cases") / "paper_model_two.toml", 299_164, 1.984, 20e6),
+    "paper_model_two_5.0s.npz": (Path("cases") / "paper_model_two.toml", 299_164, 4.959, 20e6),
 }
 
 
 @pytest.mark.parametrize("name", sorted(PAPER_STATES))
 def test_shipped_paper_states_fit_their_cases(name: str) -> None:
-    run, count, time_s = PAPER_STATES[name]
+    case_file, count, time_s, size = PAPER_STATES[name]
     path = ROOT / "results" / "states" / name
     state = read_state(path)
-    check_state(state, load_case(ROOT / "results" / "paper" / "levels" / "runs" / run / "case.toml"), name)
+    check_state(state, load_case(ROOT / case_file), name)
     assert len(state) == count and state.time_s == pytest.approx(time_s, abs=1e-3)
-    assert path.stat().st_size < 4_000_000  # compact enough for git (~42-52 bytes per parcel)
+    assert path.stat().st_size < size  # compact enough for git
     # Cascading at 5 s: curtains fall from the top of the 3 m drum (free fall from 1.3 m or more
     # gives 5 m/s); at 2 s the bed still rides up with the drum (its wall moves at 0.79 m/s).
     fastest = float(np.linalg.norm(state.velocities, axis=1).max())
