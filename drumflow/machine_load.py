@@ -22,9 +22,9 @@ import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
-#: Other programs' mean CPU, in cores, above which a stretch of a run is contended: a shell
-#: command or an editor stays far below it, a test suite or a second solver far above.
-BUSY_OTHER_CORES = 0.2
+#: Other programs' mean CPU, in cores, above which a run or a stretch of one is contended: an
+#: idle VM's daemons and a shell stay at 0.01-0.03, a test suite or a second solver far above.
+BUSY_OTHER_CORES = 0.1
 #: Seconds between samples: long enough to cost nothing, short enough to place a contended
 #: stretch within a minute of a run's hours.
 LOAD_PERIOD_S = 30.0
@@ -139,38 +139,44 @@ def read_load_log(path: Path) -> pd.DataFrame:
     return table.dropna(subset=["time_unix", "other_cores"]).reset_index(drop=True)
 
 
+def sample_spans(times: NDArray[np.float64], period: float = LOAD_PERIOD_S) -> NDArray[np.float64]:
+    """Wall seconds each sample's means cover: the gap to the previous sample, or
+    :data:`FIRST_SAMPLE_S` for an attempt's first (a gap much longer than the period is a new
+    attempt: the run was not going in between)."""
+    spans = np.full(len(times), FIRST_SAMPLE_S)
+    if len(times) > 1:
+        gaps = np.diff(times)
+        spans[1:] = np.where(gaps < 4 * period, gaps, FIRST_SAMPLE_S)
+    return spans
+
+
 def contended_stretches(table: pd.DataFrame, threshold: float = BUSY_OTHER_CORES
                         ) -> list[tuple[float, float, float]]:
     """The stretches where other programs took more than ``threshold`` cores.
 
-    Each is ``(start, end, mean other cores)``, in the log's unix times; a sample's stretch
-    begins at the previous sample (or ``period`` before, for an attempt's first).
+    Each is ``(start, end, mean other cores)`` in the log's unix times, the start being where
+    its first sample's span begins (:func:`sample_spans`); a stretch never spans two attempts.
     """
-    if table.empty:
-        return []
     times = table["time_unix"].to_numpy(float)
     other = table["other_cores"].to_numpy(float)
-    gaps = times[1:] - times[:-1]
-    regular = gaps[(gaps > 0) & (gaps < 4 * LOAD_PERIOD_S)]
-    period = float(np.median(regular)) if len(regular) else LOAD_PERIOD_S
+    spans = sample_spans(times)
     stretches: list[tuple[float, float, float]] = []
     current: list[int] = []
     for i, value in enumerate(other):
-        # A gap much longer than the period is a new attempt: a stretch does not span it.
-        joined = bool(current) and times[i] - times[current[-1]] < 4 * period
-        if value > threshold and (joined or not current):
-            current.append(i)
-            continue
-        if current:
-            stretches.append(_stretch(current, times, other, period))
+        # A sample that starts an attempt (its span is not the gap) closes the stretch before.
+        joined = bool(current) and spans[i] == times[i] - times[current[-1]]
+        if current and not (value > threshold and joined):
+            stretches.append(_stretch(current, times, other, spans))
             current = []
         if value > threshold:
-            current = [i]
+            current.append(i)
     if current:
-        stretches.append(_stretch(current, times, other, period))
+        stretches.append(_stretch(current, times, other, spans))
     return stretches
 
 
 def _stretch(rows: list[int], times: NDArray[np.float64], other: NDArray[np.float64],
-             period: float) -> tuple[float, float, float]:
-    return float(times[rows[0]] - period), float(times[rows[-1]]), float(other[rows].mean())
+             spans: NDArray[np.float64]) -> tuple[float, float, float]:
+    weights = spans[rows]
+    return (float(times[rows[0]] - spans[rows[0]]), float(times[rows[-1]]),
+            float((other[rows] * weights).sum() / weights.sum()))

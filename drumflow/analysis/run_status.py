@@ -20,11 +20,14 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+import pandas as pd
+
 from drumflow.coupling.log import read_coupling, update_walls
 from drumflow.coupling.spec import STOPPED_RECORD
-from drumflow.dem.stage import restart_files
+from drumflow.dem.stage import LOAD_LOG, restart_files
 from drumflow.dem.thermo import COLUMNS, ThermoParser, log_files
 from drumflow.errors import DrumflowError, MissingRunFileError
+from drumflow.machine_load import contended_stretches, read_load_log, sample_spans
 from drumflow.readers import read_json_object
 from drumflow.rundir import read_stage_marker
 
@@ -37,6 +40,8 @@ RECENT_UPDATES = 20
 #: A run without a process record counts as running while its log is younger than this, s: a
 #: paper-scale run writes a thermo row every update (about 15 s for model one).
 RUNNING_LOG_AGE_S = 300.0
+#: Wall seconds of the load log the status averages other programs' CPU over.
+RECENT_LOAD_S = 600.0
 #: Bytes read from the end of the newest LIGGGHTS log for its last thermo row.
 LOG_TAIL_BYTES = 65536
 
@@ -78,6 +83,12 @@ class RunStatus:
     stopped_on_request_s
         Where the coupling loop wrote its restart when it was last asked to stop (``drumflow
         stop``, an interrupt, a SLURM time-limit warning), s; None if the last attempt was not.
+    other_cores_recent
+        Other programs' mean CPU, in cores, over the load log's last :data:`RECENT_LOAD_S`
+        (:mod:`drumflow.machine_load`): the pace above is the run's own only when this is near 0.
+    contended_s, load_logged_s
+        Wall seconds of the load log's contended stretches (others above
+        :data:`drumflow.machine_load.BUSY_OTHER_CORES`), and of all it covers; None without a log.
     time_step_s, new_run_time_step_s
         The run's DEM step (it keeps it when resumed) and the step a new run of the same case
         would take with this drumflow (they differ for a run started before "auto" came to
@@ -103,6 +114,9 @@ class RunStatus:
     restart_bytes: int
     output_bytes: int
     stopped_on_request_s: float | None = None
+    other_cores_recent: float | None = None
+    contended_s: float | None = None
+    load_logged_s: float | None = None
     time_step_s: float | None = None
     new_run_time_step_s: float | None = None
 
@@ -251,9 +265,31 @@ def run_status(run_dir: Path | str, now: float | None = None) -> RunStatus:
         restart_bytes=restart_bytes,
         output_bytes=total - restart_bytes,
         stopped_on_request_s=_stopped_on_request(dem),
+        **_machine_load(dem / LOAD_LOG),
         time_step_s=float(time_step) if time_step else None,
         new_run_time_step_s=_new_run_time_step(case) if time_step else None,
     )
+
+
+def _machine_load(path: Path) -> dict[str, float | None]:
+    """The load log's recent contention and its contended share (None without a log)."""
+    none: dict[str, float | None] = {"other_cores_recent": None, "contended_s": None,
+                                     "load_logged_s": None}
+    if not path.is_file():
+        return none
+    try:
+        table = read_load_log(path)
+    except (ValueError, OSError, pd.errors.ParserError, pd.errors.EmptyDataError):
+        return none  # a status must stay readable; the log is a diagnostic
+    if table.empty:
+        return none
+    times = table["time_unix"].to_numpy(float)
+    recent = table[times >= times[-1] - RECENT_LOAD_S]
+    stretches = contended_stretches(table)
+    logged = float(sample_spans(times).sum())
+    return {"other_cores_recent": float(recent["other_cores"].mean()),
+            "contended_s": float(sum(end - start for start, end, _ in stretches)),
+            "load_logged_s": logged}
 
 
 def _new_run_time_step(case: Case) -> float | None:

@@ -41,28 +41,23 @@ from typing import Any
 import pandas as pd
 
 from drumflow.bench.settings import (
-    baseline_deck,
-    check_scene,
     machine_info,
     measure_variant,
+    open_coupled_run,
     physics_check,
     prepare_variant,
-    restart_file,
 )
 from drumflow.case import Case
 from drumflow.coupling.spec import COUPLING_FILE, LIBRARY_RECORD, driver_command
 from drumflow.dem.stage import finished_loop
 from drumflow.errors import SettingsStudyError, SolverNotFoundError
-from drumflow.machine_load import machine_busy_cpu_s
-from drumflow.rundir import RunDir
+from drumflow.machine_load import BUSY_OTHER_CORES, machine_busy_cpu_s
 from drumflow.runner import LIBRARY_VARIABLE, LaunchProfile, LiggghtsBuild, Runner, liggghts_build
 
 __all__ = ["BUSY_OTHER_CORES", "DEBIAN", "Arm", "Comparison", "build_arms", "level_arms", "run_arms"]
 
 #: The name that means the Debian package's LIGGGHTS.
 DEBIAN = "debian"
-#: Other programs' mean CPU use during a run, in cores, above which the run is marked contended.
-BUSY_OTHER_CORES = 0.1
 _DEBIAN_BUILD = LiggghtsBuild(None, "liggghts", None, None)
 #: The coupling loop's inputs of each physics level above the paper's (drumflow.coupling.spec).
 _INTERIOR, _WARMING = "interior", "warming"
@@ -278,18 +273,10 @@ def run_arms(case: Case, run_dir: Path, out: Path, arms: Sequence[Arm] | None = 
             raise SettingsStudyError(f"{field_name} = {value}: must be at least 1")
     kind = "builds" if arms is None and builds is not None else "levels" if arms is None else "arms"
     chosen = list(arms) if arms is not None else build_arms(builds) if builds is not None else None
-    rundir = RunDir.existing(run_dir)
-    check_scene(case, rundir)
-    driver_path = rundir.dem / COUPLING_FILE
-    if not driver_path.is_file():
-        raise SettingsStudyError(f"{driver_path}: missing; the comparison runs the coupling loop, so "
-                                 "the run must have air (air.model 'uniform' or 'cfd')")
-    driver = json.loads(driver_path.read_text())
+    opened = open_coupled_run(case, run_dir, restart_step, ranks, out / "runs", "the comparison")
+    rundir, driver, restart, start = opened.rundir, opened.driver, opened.restart, opened.start
+    deck, deck_source, scratch = opened.deck, opened.deck_source, opened.scratch
     chosen = chosen if chosen is not None else level_arms(driver, rundir.root)
-    restart, start = restart_file(rundir, restart_step)
-    scratch = out / "runs"
-    scratch.mkdir(parents=True, exist_ok=True)
-    deck, deck_source = baseline_deck(rundir, start, ranks, scratch, driver)
     meta: dict[str, Any] = {
         "kind": kind, "run_dir": str(rundir.root.resolve()), "restart": str(restart),
         "restart_step": start, "steps": steps, "ranks": ranks, "repeats": repeats,

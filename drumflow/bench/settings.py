@@ -321,6 +321,47 @@ def earlier_rows(out: Path, meta: dict[str, Any]) -> dict[str, dict[str, Any]]:
     return {str(r["variant"]): r for r in old.get("results", []) if r.get("status") == "ok"}
 
 
+@dataclass(frozen=True)
+class CoupledStart:
+    """A coupled run opened for runs from one of its restarts (:func:`open_coupled_run`)."""
+
+    rundir: RunDir
+    #: The run's coupling-loop input (``dem/coupling.json``).
+    driver: dict[str, Any]
+    restart: Path
+    start: int
+    #: The baseline deck and where it came from (:func:`baseline_deck`).
+    deck: str
+    deck_source: str
+    #: The folder the runs go in (created).
+    scratch: Path
+
+
+def open_coupled_run(case: Case, run_dir: Path, restart_step: int | None, ranks: int, scratch: Path,
+                     who: str) -> CoupledStart:
+    """Check that ``run_dir`` is a coupled run of ``case``'s scene and open its restart.
+
+    Shared by the settings study and the interleaved arms (:mod:`drumflow.bench.interleaved`);
+    ``who`` names the caller in the error.
+
+    Raises
+    ------
+    SettingsStudyError
+        Not a run directory, another scene, no coupling loop (no air), no such restart.
+    """
+    rundir = RunDir.existing(run_dir)
+    check_scene(case, rundir)
+    driver_path = rundir.dem / COUPLING_FILE
+    if not driver_path.is_file():
+        raise SettingsStudyError(f"{driver_path}: missing; {who} runs the coupling loop, so "
+                                 "the run must have air (air.model 'uniform' or 'cfd')")
+    driver = json.loads(driver_path.read_text())
+    restart, start = restart_file(rundir, restart_step)
+    scratch.mkdir(parents=True, exist_ok=True)
+    deck, deck_source = baseline_deck(rundir, start, ranks, scratch, driver)
+    return CoupledStart(rundir, driver, restart, start, deck, deck_source, scratch)
+
+
 def run_settings_study(case: Case, run_dir: Path, out: Path, steps: int = 400, ranks: int = 2,
                        restart_step: int | None = None, only: list[str] | None = None,
                        timeout: float = 3600.0,
@@ -365,17 +406,9 @@ def run_settings_study(case: Case, run_dir: Path, out: Path, steps: int = 400, r
     unknown = [n for n in (only or []) if n not in known]
     if unknown:
         raise SettingsStudyError(f"unknown variant(s) {', '.join(unknown)}; known: {', '.join(known)}")
-    rundir = RunDir.existing(run_dir)
-    check_scene(case, rundir)
-    driver_path = rundir.dem / COUPLING_FILE
-    if not driver_path.is_file():
-        raise SettingsStudyError(f"{driver_path}: missing; the study runs the coupling loop, so "
-                                 "the run must have air (air.model 'uniform' or 'cfd')")
-    driver = json.loads(driver_path.read_text())
-    restart, start = restart_file(rundir, restart_step)
-    scratch = out / "variants"
-    scratch.mkdir(parents=True, exist_ok=True)
-    deck, deck_source = baseline_deck(rundir, start, ranks, scratch, driver)
+    opened = open_coupled_run(case, run_dir, restart_step, ranks, out / "variants", "the study")
+    rundir, driver, restart, start = opened.rundir, opened.driver, opened.restart, opened.start
+    deck, deck_source, scratch = opened.deck, opened.deck_source, opened.scratch
     variants = [v for v in VARIANTS if v.name == "baseline" or only is None or v.name in only]
     meta: dict[str, Any] = {"run_dir": str(rundir.root.resolve()), "restart": str(restart),
                             "restart_step": start, "steps": steps, "ranks": ranks}

@@ -188,6 +188,7 @@ def status(
 ) -> None:
     """Where a run stands (running, interrupted or finished): time reached, pace, ETA, disk."""
     from drumflow.analysis.run_status import RECENT_UPDATES, run_status
+    from drumflow.dem.stage import LOAD_LOG
 
     st = run_status(run_dir)
     if as_json:
@@ -218,6 +219,10 @@ def status(
                       f"(last {RECENT_UPDATES} air updates)")
     if st.eta_s is not None:
         table.add_row("to the end at that pace", clock(st.eta_s))
+    if st.other_cores_recent is not None and st.load_logged_s is not None:
+        table.add_row("other programs", f"{st.other_cores_recent:.2f} cores over the last 10 min; "
+                      f"contended {clock(st.contended_s or 0.0)} of {clock(st.load_logged_s)} logged "
+                      f"(dem/{LOAD_LOG})")
     if st.restart_step is not None:
         table.add_row("a resume starts from", f"restart of step {st.restart_step:,} "
                       f"({st.restart_time_s:.3f} s)" if st.restart_time_s is not None

@@ -21,9 +21,10 @@ PACKAGE = Path(__file__).resolve().parents[2] / "drumflow"
 #: ``runner`` the one process runner, ``readers`` the guarded file readers, ``_json`` JSON
 #: that survives NaN, ``_lazy`` the lazy re-exports of the stage packages, ``skips`` why a
 #: finished stage is skipped, ``convergence`` the pure convergence tests of a series, ``_mpl``
-#: matplotlib imported when a picture is first drawn.
+#: matplotlib imported when a picture is first drawn, ``machine_load`` what else the machine
+#: did while the runner's program ran.
 GROUND_FLOOR = ["case", "errors", "rundir", "runner", "readers", "_json", "_lazy", "_mpl", "skips",
-                "convergence"]
+                "convergence", "machine_load"]
 
 #: The floors in order, lowest first. A room may import a lower one (or the ground floor),
 #: never a higher one: the physics floor (laws and properties) under the simulation stages in

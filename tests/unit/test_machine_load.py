@@ -53,8 +53,10 @@ def test_contended_stretches_join_neighbours_and_split_attempts() -> None:
     table = pd.DataFrame({"time_unix": times, "load_1min": 2.0, "busy_cores": 2.0,
                           "run_cores": 2.0, "other_cores": other})
     stretches = contended_stretches(table)
-    assert [(round(a - t0), round(b - t0)) for a, b, _ in stretches] == [(0, 60), (120, 150), (3570, 3630)]
+    assert [(round(a - t0), round(b - t0)) for a, b, _ in stretches] == [(0, 60), (120, 150), (3597, 3630)]
     assert stretches[0][2] == pytest.approx(0.7)
+    # Means weighted by the samples' spans: the attempt's first sample covers its first 3 s.
+    assert stretches[2][2] == pytest.approx((0.4 * 3 + 0.6 * 30) / 33)
     assert contended_stretches(table, threshold=1.0) == []
 
 

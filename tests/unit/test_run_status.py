@@ -205,3 +205,26 @@ def test_a_run_stopped_on_request_says_so(tmp_path: Path) -> None:
         os.utime(log, (old, old))
     result = CliRunner().invoke(app, ["status", str(run)])
     assert "stopped on request at 0.25 s" in " ".join(result.output.split())
+
+
+def test_the_status_says_what_else_the_machine_did(tmp_path: Path) -> None:
+    # Two attempts of 30 s samples: the first quiet, then 3 contended samples (90 s); the
+    # second, an hour later, contended in its last two (60 s). Each attempt's first sample
+    # comes 3 s after its start: 153 + 93 s logged.
+    run = _write_run(tmp_path / "run", last_step=2500, update_walls=[2.0] * 5)
+    t0 = 1.8e9
+    rows = [(t0 + 30 * i, o) for i, o in enumerate([0.0, 0.0, 0.5, 1.0, 0.6, 0.0])]
+    rows += [(t0 + 3600 + 30 * i, o) for i, o in enumerate([0.0, 0.05, 0.9, 0.7])]
+    (run / "dem" / "machine_load.csv").write_text(
+        "time_unix,load_1min,busy_cores,run_cores,other_cores\n"
+        + "".join(f"{t:.1f},2.5,2.0,{2.0 - o:.3f},{o:.3f}\n" for t, o in rows))
+    st = run_status(run)
+    assert st.contended_s == pytest.approx(150.0)
+    assert st.load_logged_s == pytest.approx(3 + 5 * 30 + 3 + 3 * 30)
+    # The last 10 minutes hold the second attempt's four samples.
+    assert st.other_cores_recent == pytest.approx((0.0 + 0.05 + 0.9 + 0.7) / 4)
+    result = CliRunner().invoke(app, ["status", str(run)])
+    assert "0.41 cores over the last 10 min; contended 0:02:30" in result.output, result.output
+    # Without a log (a run of an older drumflow) there is no row, and a damaged log is no error.
+    (run / "dem" / "machine_load.csv").write_text("nonsense\n")
+    assert run_status(run).contended_s is None
