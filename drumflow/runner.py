@@ -189,6 +189,8 @@ class LaunchProfile:
 PREFIX_VARIABLE = "DRUMFLOW_LIGGGHTS_PREFIX"
 #: The library the coupling loop loads (drumflow.coupling.library).
 LIBRARY_VARIABLE = "DRUMFLOW_LIGGGHTS_LIBRARY"
+#: The Debian package's library, by its soname (the dynamic loader finds it).
+SYSTEM_LIBRARY = "libliggghts.so.3"
 #: The file of a build's prefix that records its compiler and flags.
 BUILD_FLAGS_FILE = "build-flags.txt"
 
@@ -223,6 +225,10 @@ class LiggghtsBuild:
         return {"source": "built from source", "prefix": self.prefix, "flags": self.flags}
 
 
+#: The Debian package's LIGGGHTS, the default.
+DEBIAN_LIGGGHTS = LiggghtsBuild(None, "liggghts", None, None)
+
+
 def liggghts_build(prefix: str | None = None) -> LiggghtsBuild:
     """The LIGGGHTS build at ``prefix``, or the one ``DRUMFLOW_LIGGGHTS_PREFIX`` names, or the
     Debian package.
@@ -235,7 +241,7 @@ def liggghts_build(prefix: str | None = None) -> LiggghtsBuild:
     """
     prefix = prefix if prefix is not None else (os.environ.get(PREFIX_VARIABLE) or None)
     if prefix is None:
-        return LiggghtsBuild(None, "liggghts", None, None)
+        return DEBIAN_LIGGGHTS
     root = Path(prefix)
     executable, library = root / "bin" / "liggghts", root / "lib" / "libliggghts.so.3"
     missing = [str(p) for p in (executable, library) if not p.is_file()]

@@ -52,13 +52,20 @@ from drumflow.coupling.spec import COUPLING_FILE, LIBRARY_RECORD, driver_command
 from drumflow.dem.stage import finished_loop
 from drumflow.errors import SettingsStudyError, SolverNotFoundError
 from drumflow.machine_load import BUSY_OTHER_CORES, machine_busy_cpu_s
-from drumflow.runner import LIBRARY_VARIABLE, LaunchProfile, LiggghtsBuild, Runner, liggghts_build
+from drumflow.runner import (
+    DEBIAN_LIGGGHTS,
+    LIBRARY_VARIABLE,
+    SYSTEM_LIBRARY,
+    LaunchProfile,
+    LiggghtsBuild,
+    Runner,
+    liggghts_build,
+)
 
 __all__ = ["BUSY_OTHER_CORES", "DEBIAN", "Arm", "Comparison", "build_arms", "level_arms", "run_arms"]
 
 #: The name that means the Debian package's LIGGGHTS.
 DEBIAN = "debian"
-_DEBIAN_BUILD = LiggghtsBuild(None, "liggghts", None, None)
 #: The coupling loop's inputs of each physics level above the paper's (drumflow.coupling.spec).
 _INTERIOR, _WARMING = "interior", "warming"
 
@@ -81,7 +88,7 @@ class Arm:
 
     name: str
     description: str
-    build: LiggghtsBuild = _DEBIAN_BUILD
+    build: LiggghtsBuild = DEBIAN_LIGGGHTS
     drop: tuple[str, ...] = ()
     same_physics: bool = True
 
@@ -124,7 +131,7 @@ def build_arms(names: Sequence[str]) -> list[Arm]:
     arms = []
     for name in names:
         try:
-            build = _DEBIAN_BUILD if name == DEBIAN else liggghts_build(name)
+            build = DEBIAN_LIGGGHTS if name == DEBIAN else liggghts_build(name)
         except SolverNotFoundError as exc:
             # A name typed on the command line: bad input (exit 2), not a failed run.
             raise SettingsStudyError(f"--builds: {exc.reason}") from None
@@ -161,7 +168,7 @@ def _profile_for(build: LiggghtsBuild) -> LaunchProfile:
     profile = LaunchProfile()
     profile.liggghts = build.executable
     # Set either way: the Debian library by its soname even when the environment names a build.
-    profile.env[LIBRARY_VARIABLE] = build.library or "libliggghts.so.3"
+    profile.env[LIBRARY_VARIABLE] = build.library or SYSTEM_LIBRARY
     return profile
 
 

@@ -15,8 +15,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from drumflow.errors import SolverNotFoundError
+from drumflow.runner import LIBRARY_VARIABLE, SYSTEM_LIBRARY
 
-LIBRARY = os.environ.get("DRUMFLOW_LIGGGHTS_LIBRARY", "libliggghts.so.3")
+#: The library to load: the build the runner's launch profile named, else Debian's.
+LIBRARY = os.environ.get(LIBRARY_VARIABLE, SYSTEM_LIBRARY)
 
 
 def loaded_library_path() -> str | None:
