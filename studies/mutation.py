@@ -82,7 +82,7 @@ def _copy_tree(scratch: Path) -> None:
             shutil.copy2(src, dst)
 
 
-def _configure(scratch: Path, names: list[str]) -> None:
+def _configure(scratch: Path, names: list[str], timeout_multiplier: float) -> None:
     sources = [MODULES[n][0] for n in names]
     tests = sorted({t for n in names for t in MODULES[n][1]})
     block = ["", "[tool.mutmut]", 'source_paths = ["drumflow"]',
@@ -92,7 +92,10 @@ def _configure(scratch: Path, names: list[str]) -> None:
              # Folders (mutmut copies a file only where its folder exists): the scratch copy
              # holds nothing else of results/.
              "also_copy = " + json.dumps(["cases", *sorted({str(Path(f).parent) for f in RESULTS_READ})]),
-             "use_git_change_detection = false", ""]
+             "use_git_change_detection = false",
+             # A mutant whose tests take longer than this many times the unmutated run is a
+             # timeout (not a kill); the grate's slow mutants cost 120-320 CPU s each at 15.
+             f"timeout_multiplier = {timeout_multiplier!r}", ""]
     with (scratch / "pyproject.toml").open("a") as fh:
         fh.write("\n".join(block))
 
@@ -120,6 +123,9 @@ def main() -> int:
     parser.add_argument("--scratch", type=Path, default=Path("/tmp/drumflow-mutation"))
     parser.add_argument("--max-children", type=int, default=1,
                         help="parallel mutmut workers (default 1: the machine is shared)")
+    parser.add_argument("--timeout-multiplier", type=float, default=15.0,
+                        help="mutmut's timeout_multiplier (default 15, mutmut's own); recorded in "
+                        "the summary, since a timeout is not counted as a kill")
     parser.add_argument("--out", type=Path, default=ROOT / "results" / "mutation")
     parser.add_argument("--report-only", action="store_true",
                         help="summarise the last run in --scratch without running mutmut")
@@ -128,7 +134,9 @@ def main() -> int:
     wall_file = args.scratch / "wall_time_s"
     if not args.report_only:
         _copy_tree(args.scratch)
-        _configure(args.scratch, args.modules)
+        if not args.timeout_multiplier > 0:
+            parser.error(f"--timeout-multiplier = {args.timeout_multiplier:g}: must be positive")
+        _configure(args.scratch, args.modules, args.timeout_multiplier)
         start = time.perf_counter()
         env = {**os.environ, "PYTHONDONTWRITEBYTECODE": "1"}
         subprocess.run([str(mutmut), "run", "--max-children", str(args.max_children)],
@@ -155,6 +163,7 @@ def main() -> int:
     for entry in this_run.values():
         entry["wall_time_s_of_run"] = round(wall, 1)
         entry["run_together_with"] = args.modules
+        entry["timeout_multiplier"] = args.timeout_multiplier
     summary["modules"] = {**earlier, **this_run}
     summary_path.write_text(json.dumps(summary, indent=2) + "\n")
     raw = args.out / "survivors_raw"
