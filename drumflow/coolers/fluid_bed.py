@@ -328,6 +328,13 @@ def operate(case: FluidBedCase, conditions: Conditions, *, convective_efficiency
     lowest = ref.min_chilled_water_C + KELVIN + ref.air_cooler_approach_K
     if isinstance(setting, float | int):
         t_cool = float(setting) + KELVIN
+        if t_cool > conditions.ambient_temperature:
+            # An air cooler cannot warm the air: above ambient it is off and the air enters
+            # as it is (not a negative duty that nothing would deliver).
+            notes.append(f"cooled-air setting {float(setting):.2f} C is above the ambient "
+                         f"{conditions.ambient_temperature - KELVIN:.2f} C: the air cooler is off "
+                         "and the air enters at ambient")
+            t_cool = conditions.ambient_temperature
     else:
         def excess(t: float) -> float:
             unit = run_unit(case, conditions, cooled_air_temperature=t, **kwargs)

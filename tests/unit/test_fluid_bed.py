@@ -307,3 +307,17 @@ def test_weather_table_has_twelve_months() -> None:
     months = fbc.load_weather("salamanca")
     assert [m.month for m in months] == list(range(1, 13))
     assert all(m.t_max_mean_C > m.t_mean_C for m in months)
+
+
+def test_a_cooled_air_setting_above_ambient_leaves_the_air_cooler_off() -> None:
+    # Regression: 45 C set on a 40 C day (when the ambient air misses the target) gave a
+    # negative cooling duty with no word.
+    case = _case(steps=20)
+    case = case.model_copy(update={"air": case.air.model_copy(update={
+        "cooled": case.air.cooled.model_copy(update={"temperature_C": 45.0})})})
+    conditions = fbc.Conditions(313.15, 0.008, case.product.inlet_temperature_C + 273.15, 293.15)
+    op = fb.operate(case, conditions)
+    assert op.cooling_needed  # the 40 C air alone does not reach the product's target
+    assert op.air_cooling is not None and op.air_cooling.duty == pytest.approx(0.0, abs=1e-6)
+    assert op.cycle is None
+    assert any("above the ambient 40.00 C: the air cooler is off" in n for n in op.notes), op.notes
