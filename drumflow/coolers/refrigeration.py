@@ -107,11 +107,19 @@ def carnot_cop(evaporating_temperature: float, condensing_temperature: float) ->
     return evaporating_temperature / (condensing_temperature - evaporating_temperature)
 
 
+#: How far outside [0, 1] a flashed quality may fall by round-off and still be on the dome.
+QUALITY_ROUND_OFF = 1e-9
+
+
 def _state(refrigerant: str, pressure: float, enthalpy: float) -> CycleState:
     t = CP.PropsSI("T", "P", pressure, "H", enthalpy, refrigerant)
     s = CP.PropsSI("S", "P", pressure, "H", enthalpy, refrigerant)
-    q = CP.PropsSI("Q", "P", pressure, "H", enthalpy, refrigerant)
-    return CycleState(float(t), pressure, enthalpy, float(s), float(q) if 0.0 <= q <= 1.0 else None)
+    q = float(CP.PropsSI("Q", "P", pressure, "H", enthalpy, refrigerant))
+    # A state put on the dew or bubble line (the evaporator's outlet, the condenser's) flashes
+    # to a quality a few ulps outside [0, 1] (1.0000000000000004): it is on the dome.
+    if -QUALITY_ROUND_OFF <= q <= 1.0 + QUALITY_ROUND_OFF:
+        return CycleState(float(t), pressure, enthalpy, float(s), min(max(q, 0.0), 1.0))
+    return CycleState(float(t), pressure, enthalpy, float(s), None)
 
 
 def polytropic_discharge_enthalpy(refrigerant: str, suction_pressure: float, suction_enthalpy: float,

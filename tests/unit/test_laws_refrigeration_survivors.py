@@ -90,9 +90,9 @@ def test_cycle_states_against_the_ammonia_table() -> None:
     = 3.91998 kJ/(kg K) (0.3 %; the identity (h_g(0) - h_f(40)) / 273.15 = 3.92008 checks the
     arithmetic); the valve's entropy generation s4 - s3 = 0.7114 + 0.69952 - 1.3574
     = 0.05352 kJ/(kg K) (1 %); the compression s2 > s1 at eta_p < 1.
-    The discharge is superheated (no quality) and state 4 inside the dome. The qualities of
-    states 1 and 3 are not asserted: CoolProp's flash returns 1 +- 4e-16 and 0 +- 1e-15 there,
-    so the module reports None at some temperatures (results/mutation/survivors.md).
+    The discharge is superheated (no quality) and state 4 inside the dome. States 1 and 3 are
+    on the dome: quality 1 and 0 exactly (CoolProp's flash returns 1 +- 4e-16 and 0 +- 1e-15
+    there, which the module reported as None before; regression).
     The reported fluid and saturation temperatures are the inputs.
     """
     cyc = refrigeration.solve_cycle(100e3, T_E, T_C, 0.75)
@@ -108,6 +108,7 @@ def test_cycle_states_against_the_ammonia_table() -> None:
     assert s4.quality is not None
     _close(s4.quality, x4, 1e-2, "state 4 quality after the valve")
     assert s2.quality is None, "the discharge is superheated"
+    assert s1.quality == 1.0 and s3.quality == 0.0, (s1.quality, s3.quality)
     assert s2.temperature > T_C
     _close((s1.entropy - s4.entropy) / 1e3, 5.3309 - 0.7114 - x4 * 4.6195, 3e-3,
            "s1 - s4 (evaporation at 0 C)")
