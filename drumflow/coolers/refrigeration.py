@@ -117,9 +117,12 @@ def _state(refrigerant: str, pressure: float, enthalpy: float) -> CycleState:
     q = float(CP.PropsSI("Q", "P", pressure, "H", enthalpy, refrigerant))
     # A state put on the dew or bubble line (the evaporator's outlet, the condenser's) flashes
     # to a quality a few ulps outside [0, 1] (1.0000000000000004): it is on the dome.
-    if -QUALITY_ROUND_OFF <= q <= 1.0 + QUALITY_ROUND_OFF:
-        return CycleState(float(t), pressure, enthalpy, float(s), min(max(q, 0.0), 1.0))
-    return CycleState(float(t), pressure, enthalpy, float(s), None)
+    # Snapped to the line, so that a saturated state reads as one (6.8e-16 is liquid).
+    for line in (0.0, 1.0):
+        if abs(q - line) <= QUALITY_ROUND_OFF:
+            q = line
+    quality = q if 0.0 <= q <= 1.0 else None
+    return CycleState(float(t), pressure, enthalpy, float(s), quality)
 
 
 def polytropic_discharge_enthalpy(refrigerant: str, suction_pressure: float, suction_enthalpy: float,
