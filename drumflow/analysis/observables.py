@@ -8,6 +8,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -93,6 +94,11 @@ class FallingMassFlow:
     window_end_s: float
     particle_mass_kg: float
     curtain_mass_flow_kg_s: float  # crossings away from the wall (lifter tip radius inwards)
+    #: Split by contact (the crossing table's ``in_contact``: 0 in free flight, 1 touching
+    #: another particle); their sum is ``mass_flow_kg_s`` when every crossing is known, NaN
+    #: when none is (a band-dump run, or an older table).
+    airborne_mass_flow_kg_s: float = math.nan
+    bed_mass_flow_kg_s: float = math.nan
 
     @property
     def window_s(self) -> float:
@@ -120,6 +126,9 @@ def falling_mass_flow(
         If given, also the mass flow of crossings with |x| below it (the falling curtain,
         without particles carried down by the lifters along the wall).
 
+    With an ``in_contact`` column known for every crossing of the window, the flow is also
+    split into the airborne part (no particle contact at the crossing) and the bed's.
+
     Returns
     -------
     FallingMassFlow
@@ -138,7 +147,13 @@ def falling_mass_flow(
     if curtain_radius is not None:
         n_curtain = int((window["x"].abs() < curtain_radius).sum())
         curtain = n_curtain * particle_mass / span if span > 0 else 0.0
-    return FallingMassFlow(flow, n, t0, t1, particle_mass, curtain)
+    airborne = bed = math.nan
+    if "in_contact" in window.columns and span > 0:
+        contact = window["in_contact"].to_numpy(float)
+        if np.isfinite(contact).all():
+            airborne = int((contact == 0).sum()) * particle_mass / span
+            bed = int((contact > 0).sum()) * particle_mass / span
+    return FallingMassFlow(flow, n, t0, t1, particle_mass, curtain, airborne, bed)
 
 
 def falling_mass_per_interval(

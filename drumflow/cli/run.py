@@ -123,6 +123,8 @@ def _print_summary(summary: dict, out: Path, as_json: bool) -> None:
         ("mean_temperature_C", "mean temperature at end (°C)", "{:.4f}"),
         ("falling_mass_flow_kg_s", "falling mass flow (kg/s)", "{:.4g}"),
         ("curtain_mass_flow_kg_s", "  of which curtain (kg/s)", "{:.4g}"),
+        ("airborne_mass_flow_kg_s", "  airborne: no particle contact (kg/s)", "{:.4g}"),
+        ("bed_mass_flow_kg_s", "  the bed: in contact (kg/s)", "{:.4g}"),
         ("wall_time_s", "wall time (s)", "{:.1f}"),
         ("particle_steps_per_s", "particle-steps per second", "{:,.0f}"),
         ("short_run_steps", "short run: DEM steps", "{:,}"),

@@ -62,6 +62,8 @@ class Liggghts:
         lib.lammps_extract_fix.restype = C.c_void_p
         lib.lammps_extract_global.argtypes = [C.c_void_p, C.c_char_p]
         lib.lammps_extract_global.restype = C.c_void_p
+        lib.lammps_extract_compute.argtypes = [C.c_void_p, C.c_char_p, C.c_int, C.c_int]
+        lib.lammps_extract_compute.restype = C.c_void_p
         lib.lammps_close.argtypes = [C.c_void_p]
         self._lib = lib
         argv_list = [b"liggghts", *[a.encode() for a in args]]
@@ -115,6 +117,11 @@ class Liggghts:
             return np.empty((0, columns))
         rows = C.cast(ptr, C.POINTER(C.POINTER(C.c_double)))
         return np.ctypeslib.as_array(rows[0], shape=(n, columns))
+
+    def compute_atom_vector(self, compute_id: str) -> NDArray[np.float64]:
+        """A per-atom vector of a compute (evaluated now if not at this step), length nlocal."""
+        ptr = self._lib.lammps_extract_compute(self._handle, compute_id.encode(), 1, 1)
+        return self._view(ptr, compute_id)
 
     def _view(self, ptr: int | None, name: str) -> NDArray[np.float64]:
         if not ptr:

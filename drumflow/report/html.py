@@ -106,6 +106,8 @@ _SUMMARY_LABELS = {
     "mean_temperature_C": "mean temperature at end, °C",
     "falling_mass_flow_kg_s": "falling mass flow (Eq. 57), kg/s",
     "curtain_mass_flow_kg_s": "of which curtain, kg/s",
+    "airborne_mass_flow_kg_s": "airborne (no particle contact at the crossing), kg/s",
+    "bed_mass_flow_kg_s": "the bed (in contact at the crossing), kg/s",
     "falling_crossings": "crossings counted",
     "wall_time_s": "wall time, s",
     "particle_steps_per_s": "particle-steps per second",

@@ -4,9 +4,12 @@ same table from the same positions."""
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
+import pytest
 
 from drumflow.analysis.observables import crossings_from_rows
 from drumflow.coupling.crossings import downward_crossings, read_loop_crossings
@@ -39,15 +42,61 @@ def test_loop_crossings_equal_the_dump_route(tmp_path: Path) -> None:
     assert len(loop) == len(dump) > 50
     order = np.lexsort((loop[:, 1], loop[:, 0]))
     expected = dump.sort_values(["time", "id"]).to_numpy()
-    np.testing.assert_allclose(loop[order], expected, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(loop[order][:, :4], expected, rtol=0, atol=1e-12)
+    assert np.isnan(loop[:, 4]).all()  # no contact counts given: unknown
     # Written and read back as the loop writes it (10 and 8 significant digits).
     path = tmp_path / "crossings.csv"
     path.write_text("time,id,x,z\n" + "".join(f"{t:.10g},{int(i)},{x:.8g},{z:.8g}\n"
-                                              for t, i, x, z in loop))
+                                              for t, i, x, z, _ in loop))
     back = read_loop_crossings(path)
-    assert sorted(back[:, 1].astype(int)) == sorted(loop[:, 1].astype(int))
-    np.testing.assert_allclose(np.sort(back[:, 0]), np.sort(loop[:, 0]), rtol=1e-9)
-    assert read_loop_crossings(_empty(tmp_path)).shape == (0, 4)
+    assert sorted(back["id"]) == sorted(loop[:, 1].astype(int))
+    np.testing.assert_allclose(back["time"], np.sort(loop[:, 0]), rtol=1e-9)
+    # A table of a drumflow before the contact column: contacts unknown.
+    assert back["in_contact"].isna().all()
+    assert read_loop_crossings(_empty(tmp_path)).shape == (0, 5)
+
+
+def test_a_crossing_is_airborne_only_without_contact_at_both_updates() -> None:
+    ids = np.arange(1, 5)
+    before = np.array([[0.0, 0.1, 0.0], [0.2, 0.1, 0.0], [0.4, 0.1, 0.0], [0.6, 0.1, 0.0]])
+    after = before - [0.0, 0.2, 0.0]  # all four cross at mid-interval
+    touching_before = np.array([0.0, 2.0, 0.0, np.nan])
+    touching_after = np.array([0.0, 0.0, 1.0, 0.0])
+    rows = downward_crossings(1.0, 1.1, ids, before, after, touching_before, touching_after)
+    by_id = {int(r[1]): r[4] for r in rows}
+    assert by_id[1] == 0.0  # free at both updates: airborne
+    assert by_id[2] == 1.0 and by_id[3] == 1.0  # touching at either: the bed
+    assert np.isnan(by_id[4])  # unknown at one update: unknown
+    np.testing.assert_allclose(rows[:, 0], 1.05)
+
+
+def test_the_falling_flow_splits_by_contact() -> None:
+    from drumflow.analysis.observables import falling_mass_flow
+
+    # 11 crossings over 1.0-2.0 s (one before the window): 3 airborne, 7 in the bed.
+    times = [0.5, *np.linspace(1.0, 2.0, 10)]
+    contact = [0.0, 0, 1, 1, 0, 1, 1, 1, 0, 1, 1]
+    table = pd.DataFrame({"time": times, "id": range(11), "x": 0.0, "z": 0.0, "in_contact": contact})
+    flow = falling_mass_flow(table, 0.5, start=1.0)
+    assert flow.mass_flow_kg_s == pytest.approx(10 * 0.5 / 1.0)
+    assert flow.airborne_mass_flow_kg_s == pytest.approx(3 * 0.5)
+    assert flow.bed_mass_flow_kg_s == pytest.approx(7 * 0.5)
+    # One unknown crossing in the window: no split (never a split of part of the crossings).
+    table.loc[5, "in_contact"] = np.nan
+    assert math.isnan(falling_mass_flow(table, 0.5, start=1.0).airborne_mass_flow_kg_s)
+    # A table without the column (the band dump's route).
+    assert math.isnan(falling_mass_flow(table.drop(columns="in_contact"), 0.5).bed_mass_flow_kg_s)
+
+
+def test_post_keeps_the_contact_column_only_where_it_is_known(tmp_path: Path) -> None:
+    from drumflow.pipeline import write_crossings_csv
+
+    table = pd.DataFrame({"time": [1.0, 2.0], "id": [3, 4], "x": [0.1, 0.2], "z": [0.0, 0.0],
+                          "in_contact": [0.0, np.nan]})
+    write_crossings_csv(tmp_path / "a.csv", table)
+    assert (tmp_path / "a.csv").read_text() == "time,id,x,z,in_contact\n1,3,0.1,0,0\n2,4,0.2,0,\n"
+    write_crossings_csv(tmp_path / "b.csv", table.assign(in_contact=np.nan))
+    assert (tmp_path / "b.csv").read_text().splitlines()[0] == "time,id,x,z"
 
 
 def _empty(tmp_path: Path) -> Path:
