@@ -81,8 +81,8 @@ from drumflow.bench.answer_rule import (
 )
 from drumflow.bench.answer_wall import wall_per_update
 from drumflow.case import Case
-from drumflow.convergence import MSER_BATCH, batch_means, mser_truncation
-from drumflow.coupling.stop import StopMonitor, min_stop_time
+from drumflow.convergence import MSER_BATCH, batch_means, cycle_means
+from drumflow.coupling.stop import StopMonitor, discharge_cycle, min_stop_time
 from drumflow.errors import (
     AnalysisInputError,
     MissingRunFileError,
@@ -381,7 +381,7 @@ def _row(t: float, case: Case, run: RunDir, result: MethodologyResult | None,
     upto = crossings[crossings["time"] <= t + TIME_EPS_S]
     eq57 = falling_mass_flow(upto, float(monitor.rule["particle_mass_kg"]), start=start)
     row["eq57_mass_flow_kg_s"] = eq57.mass_flow_kg_s if eq57.crossings >= 2 else math.nan
-    row.update(_steady_mass_flow(temps, start, t))
+    row.update(_steady_mass_flow(temps, start, t, discharge_cycle(case)))
 
     # The stop rule on the updates up to t.
     n = int(np.searchsorted(updates["time_s"].to_numpy(float), t + TIME_EPS_S, side="right"))
@@ -417,10 +417,17 @@ def _row(t: float, case: Case, run: RunDir, result: MethodologyResult | None,
     return row
 
 
-def _steady_mass_flow(temps: pd.DataFrame, start: float, t: float) -> dict[str, float]:
+def _steady_mass_flow(temps: pd.DataFrame, start: float, t: float,
+                      period: float) -> dict[str, float]:
     """The falling mass flow of the cascading bed: the window's per-output-step rate from the
-    end of its start-up transient (:func:`drumflow.convergence.mser_truncation`) to ``t``.
+    end of its start-up transient to ``t``, over whole lifter cycles of ``period`` s.
 
+    The interval is the online rule's (:func:`drumflow.convergence.cycle_means`, as
+    :meth:`drumflow.coupling.stop.StopMonitor.intervals` forms it, here on the output steps): the
+    cut is MSER-5 on the rate less its mean profile over a cycle, up to the next whole cycle,
+    and the batches are whole cycles. 20 equal batches (the replay's rule before issue 35) are
+    shorter than the lifters' period and alias it: on paper model one at 12.12 s they gave
+    +-3.7 % for a flow whose whole cycles scatter by +-1.2 % (``docs/flow-uncertainty.md``).
     The paper's window opens at a fixed 1 s, while the flights are still filling for the first
     time, so its average keeps rising with the run's length; the steady flow does not.
     """
@@ -434,11 +441,9 @@ def _steady_mass_flow(temps: pd.DataFrame, start: float, t: float) -> dict[str, 
     if rate.size < 2 * MSER_BATCH:
         return {"steady_mass_flow_kg_s": math.nan, "steady_mass_flow_half_width_kg_s": math.nan,
                 "steady_start_s": math.nan}
-    cut = mser_truncation(rate)
-    kept = rate[cut:]
-    return {"steady_mass_flow_kg_s": float(np.sum(kept * gaps[cut:]) / np.sum(gaps[cut:])),
-            "steady_mass_flow_half_width_kg_s": batch_means(kept, gaps[cut:]).half_width,
-            "steady_start_s": float(times[inside][cut] - gaps[cut])}
+    flow = cycle_means(rate, gaps, times[inside], period, start, truncation="samples")
+    return {"steady_mass_flow_kg_s": flow.mean, "steady_mass_flow_half_width_kg_s": flow.half_width,
+            "steady_start_s": flow.window_start}
 
 
 def _merge_no_h(notes: list[str]) -> tuple[str, ...]:

@@ -18,10 +18,14 @@ Every ``check_every`` steps rank 0 forms both intervals with whole lifter cycles
 after MSER's cut of the start-up (:func:`drumflow.convergence.cycle_means`: the intervals are
 the cascading bed's, and no batch mixes phases of the discharge; batch means of 20 equal
 batches were up to six times wider, or flagged correlated while the bed formed, and never let
-the paper runs stop), asks :func:`drumflow.convergence.decide` whether both are
-narrower than the tolerance and shares its verdict with a second reduction, so that every rank
-leaves the loop at the same step. Rank 0 logs the series to
-``coupling/convergence.csv`` (read back on resume) and the verdict to ``coupling/stop.json``.
+the paper runs stop). The cut is MSER-5 on the samples less their mean profile over a cycle,
+up to the next whole cycle (since issue 35: MSER on the cycle means themselves picked the
+cycles that strayed and under-covered, 0.91-0.93 for 95 %; ``docs/flow-uncertainty.md``); the
+replay's steady flow (:mod:`drumflow.bench.answer`) forms the same interval. The loop then
+asks :func:`drumflow.convergence.decide` whether both are narrower than the tolerance and
+shares its verdict with a second reduction, so that every rank leaves the loop at the same
+step. Rank 0 logs the series to ``coupling/convergence.csv`` (read back on resume) and the
+verdict to ``coupling/stop.json``.
 """
 
 from __future__ import annotations
@@ -231,15 +235,15 @@ class StopMonitor:
 
     def intervals(self) -> dict[str, MeanInterval]:
         """Both intervals on the series so far, each from whole discharge cycles after MSER's
-        cut of the start-up (:func:`drumflow.convergence.cycle_means`): the cascading bed's h
-        and falling mass flow. Batch means where the rule has no ``cycle_s`` (a loop input
-        written before it existed)."""
+        cut of the start-up on the samples (:func:`drumflow.convergence.cycle_means`,
+        ``truncation="samples"``): the cascading bed's h and falling mass flow. Batch means
+        where the rule has no ``cycle_s`` (a loop input written before it existed)."""
         samples = self._samples()
         cycle = self.rule.get("cycle_s")
         if cycle is None:
             return {name: batch_means(v, w) for name, (v, w, _) in samples.items()}
         start = float(self.rule["window_start_s"])
-        return {name: cycle_means(v, w, ends, float(cycle), start)
+        return {name: cycle_means(v, w, ends, float(cycle), start, truncation="samples")
                 for name, (v, w, ends) in samples.items()}
 
     def state(self, time_s: float) -> ConvergenceState:

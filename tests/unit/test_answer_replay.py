@@ -81,15 +81,20 @@ def _expected(grid: np.ndarray, h: np.ndarray, counts: np.ndarray) -> dict[str, 
 def _cycle_interval(per_step: np.ndarray, t_now: float) -> tuple[float, bool]:
     """Relative half-width of a series' mean from whole lifter cycles, by hand: the mean of each
     cycle's output steps (step j, from t_j to t_j + DT, lies in the cycle of its midpoint);
-    MSER's cut once there are ten cycles; Student's t over what is left; NaN below five cycles.
+    MSER-5's cut on the steps less their cycle profile, up to a whole cycle; Student's t over
+    what is left; NaN below five cycles.
     Also whether the cycle means pass the lag-1 independence check."""
     cycle = 60.0 / (answer_case().drum.rpm * answer_case().lifters.count)  # 0.5 s
     per = round(cycle / DT)  # output steps per cycle
     whole = int(np.floor((t_now - START) / cycle + 1e-9))
     first = round(START / DT)
     means = np.array([per_step[first + j * per: first + (j + 1) * per].mean() for j in range(whole)])
-    if means.size >= 10:
-        means = means[mser_truncation(means, batch=1):]
+    if whole:
+        # MSER-5 on the whole cycles' steps less their mean profile over a cycle, up to the
+        # next whole cycle (issue 35: the cut on the cycle means narrowed its own interval).
+        window = per_step[first: first + whole * per]
+        resid = window - np.tile(window.reshape(whole, per).mean(axis=0), whole)
+        means = means[math.ceil(mser_truncation(resid) / per - 1e-9):]
     b = means.size
     if b < 5:
         return math.nan, False
