@@ -23,8 +23,9 @@ A rung may set ``until``: its run is replayed as if it had ended there (the last
 before it), for a ladder over a window shorter than some of its runs, e.g. paper model one,
 whose full-particle run has only its first 3.5 s, against a parcel run to 17.5 s.
 
-The reference rung's answer at its end gives the errors of every rung. Its batch-means
-half-widths are the noise floor: an error below it is chaos, not a setting. Wall times are the
+The reference rung's answer at its end gives the errors of every rung. Its half-widths are the
+noise floor (the cascading bed's flow from whole lifter cycles, :func:`drumflow.convergence.cycle_means`;
+the others batch means of the per-step series): an error below it is chaos, not a setting. Wall times are the
 replay's (coupling updates, no set-up or air solve), times ``wall_scale`` when a rung's run is a
 stand-in for a run with other settings whose rate was measured side by side (the reference of
 issue 11 is the conservative settings, 2.34 times slower than the defaults from the same
@@ -68,7 +69,7 @@ class LadderQuantity(NamedTuple):
     """One quantity the ladder reports, and where the answer replay keeps it."""
 
     column: str  #: its column in the replay table
-    half_width: str  #: the reference's batch-means half-width column (the noise floor)
+    half_width: str  #: the reference's half-width column (the noise floor)
     short: str  #: for tables
     label: str  #: for people
 
@@ -80,7 +81,7 @@ LADDER_QUANTITIES: dict[str, LadderQuantity] = {
     "mass_flow": LadderQuantity("mass_flow_kg_s", "mass_flow_half_width_kg_s", "ṁ paper",
                                 "falling mass flow, paper's window"),
     "steady_mass_flow": LadderQuantity("steady_mass_flow_kg_s", "steady_mass_flow_half_width_kg_s",
-                                       "ṁ steady", "falling mass flow, cascading bed (MSER)"),
+                                       "ṁ steady", "falling mass flow, cascading bed (whole cycles)"),
     "h": LadderQuantity("h_W_m2K", "h_half_width_W_m2K", "h", "h, Eq. 39"),
 }
 _TIME_EPS_S = 1e-6
@@ -387,7 +388,7 @@ def _draw_ladder(ax: Axes, table: pd.DataFrame, tolerance: float, floor: float) 
     ax.axhline(100.0 * tolerance, color="tab:gray", ls="--", lw=1,
                label=f"tolerance {tolerance:.0%}")
     ax.axhline(100.0 * floor, color="tab:blue", ls=":", lw=1,
-               label=f"noise floor {floor:.2%} (reference's batch means)")
+               label=f"noise floor {floor:.2%} (reference's interval)")
     ax.set_xscale("log")
     ax.xaxis.set_major_formatter(ScalarFormatter())
     # Minor ticks are labelled only within a decade: over more they run into each other
