@@ -25,8 +25,9 @@ results folder with the same ``case.toml`` and ``post/`` files) at a grid of end
   start of the run (Section 2.2), only the falling mass is measured in the window; the
   column ``h_window_W_m2K`` gives the average over the window's steps alone. Their
   half-widths are batch means (:func:`drumflow.convergence.batch_means`) of the per-step
-  series (the cascading bed's steady flow, (b'), takes whole lifter cycles instead,
-  :func:`drumflow.convergence.cycle_means`, as the stop rule does): ``h`` per step, and falling mass per step over its length. The falling mass cancels
+  series: ``h`` per step, and falling mass per step over its length (the cascading bed's
+  steady flow, (b'), takes whole lifter cycles instead, :func:`drumflow.convergence.cycle_means`,
+  as the stop rule does). The falling mass cancels
   from Eq. 39 but for the air's warming (:func:`drumflow.analysis.published.eq39_as_lumped_h`), so
   the uncertainty of (b) hardly enters (c).
 * (a) is read from the series (:func:`drumflow.analysis.published.temperature_at`) once ``t``
