@@ -287,6 +287,7 @@ _ADDED_LATER: tuple[tuple[str, str, object], ...] = (
     ("air", "warming", False),
     ("run", "start_state", None),
     ("drum", "ends", "fixed"),
+    ("particles", "placement", "lattice"),
 )
 
 #: The options of :data:`_ADDED_LATER` that came after section hashes (geometry cache, start
@@ -294,4 +295,5 @@ _ADDED_LATER: tuple[tuple[str, str, object], ...] = (
 #: earlier ones were always part of those hashes, so leaving them out would change them.
 _ADDED_AFTER_SECTION_HASHES: tuple[tuple[str, str, object], ...] = (
     ("drum", "ends", "fixed"),
+    ("particles", "placement", "lattice"),
 )

@@ -134,6 +134,14 @@ class Particles(_Section):
         "radial temperature profile in concentric shells, the air's film acting on the surface "
         "(drumflow.coupling.interior; needs air). The paper's cases stay 'lumped'.",
     )
+    placement: Literal["lattice", "random"] = Field(
+        "lattice",
+        description="initial bed: 'lattice', a face-centred-cubic lattice filled from the bottom "
+        "(settles by a fraction of a diameter; the default); 'random', a loose random packing "
+        "(random sequential addition, solids fraction about 0.3, seeded by run.seed) that "
+        "settles into a random bed. Equal spheres on a lattice keep their crystal in a drum "
+        "without lifters and move as a block (drumflow.dem.placement)",
+    )
     interior_shells: int | None = Field(
         None, ge=2, le=40,
         description="shells per particle with interior = 'shells'; default: the fewest whose "

@@ -6,6 +6,14 @@ settled bed lies, with a small gap between neighbours. Dropping soft particles f
 soft particles dropped from a lattice leak through a 3 m shell within 2,500 steps; a bed
 placed near its rest position settles by only a fraction of a diameter. Writing positions to a
 LIGGGHTS data file also makes the count exact by construction.
+
+Equal spheres on a lattice are a crystal, and in a drum without lifters (a rolling drum of
+equal glass beads) the crystal survives: the bed rises with the shell as one block and slides
+back along it instead of rolling. ``particles.placement = "random"`` places them instead by
+random sequential addition (:func:`random_packing`): uniform random centres, each kept only if
+it overlaps none kept before, at a loose solids fraction (:data:`RANDOM_SOLIDS_FRACTION`, below
+the 0.38 where addition jams) over the lowest part of the drum that holds them; the bed then
+settles into a random packing, each sphere falling at most about the loose bed's height.
 """
 
 from __future__ import annotations
@@ -28,6 +36,13 @@ if TYPE_CHECKING:
 LATTICE_GAP = 0.02
 #: Clearance from shell, lifters and end planes, in diameters.
 WALL_CLEARANCE = 0.05
+#: Solids fraction of the loose random packing: random sequential addition of equal spheres
+#: jams near 0.38 (Torquato, Random Heterogeneous Materials, 2002), so 0.30 fills quickly.
+RANDOM_SOLIDS_FRACTION = 0.30
+#: Candidate centres per missing sphere in each round of random sequential addition.
+CANDIDATES_PER_SPHERE = 4
+#: Rounds without progress after which the region grows by one diameter.
+STALLED_ROUNDS = 3
 
 
 def _fcc_lattice(spacing: float, lo: NDArray, hi: NDArray) -> NDArray[np.float64]:
@@ -50,6 +65,8 @@ def place_particles(case: Case, count: int | None = None) -> NDArray[np.float64]
         When fewer sites than particles fit in the free drum volume.
     """
     n = case.particle_count if count is None else count
+    if case.particles.placement == "random":
+        return random_packing(case, n)
     d = case.particles.diameter
     R = case.drum.radius
     length = case.drum.length
@@ -70,6 +87,70 @@ def place_particles(case: Case, count: int | None = None) -> NDArray[np.float64]
     # placement is reproducible; the tilt is handled by gravity once the run starts.
     order = np.lexsort((sites[:, 2], sites[:, 0], np.round(sites[:, 1] / (0.25 * d))))
     return sites[order[:n]]
+
+
+def _free(points: NDArray[np.float64], case: Case, clearance: float) -> NDArray[np.bool_]:
+    """Centres clear of the shell, the lifters and the end planes by ``clearance``."""
+    R, length = case.drum.radius, case.drum.length
+    ok = ((np.hypot(points[:, 0], points[:, 1]) <= R - clearance)
+          & (points[:, 2] >= clearance) & (points[:, 2] <= length - clearance))
+    if case.lifters.count and ok.any():
+        ok[ok] = distance_to_lifters(points[ok, :2], R, case.lifters) >= clearance
+    return ok
+
+
+def random_packing(case: Case, n: int, max_rounds: int = 400) -> NDArray[np.float64]:
+    """``n`` non-overlapping centres by random sequential addition, lowest first.
+
+    The region is the drum's section below a level chosen so that ``n`` spheres fill it to
+    :data:`RANDOM_SOLIDS_FRACTION` (from the segment area of the circle), raised by a diameter
+    whenever :data:`STALLED_ROUNDS` rounds add nothing. Reproducible: seeded by ``run.seed``.
+
+    Raises
+    ------
+    InsertionError
+        When the whole drum cannot take ``n`` spheres this way within ``max_rounds`` rounds.
+    """
+    from scipy.spatial import cKDTree
+
+    d = case.particles.diameter
+    R, length = case.drum.radius, case.drum.length
+    clearance = (0.5 + WALL_CLEARANCE) * d
+    gap = (1.0 + LATTICE_GAP) * d
+    rng = np.random.default_rng(case.run.seed)
+    # The level whose circular segment holds the spheres at the loose fraction.
+    needed = n * case.particles.volume / RANDOM_SOLIDS_FRACTION / max(length - 2 * clearance, d)
+    level = -R
+    while level < R and R**2 * math.acos(-level / R) + level * math.sqrt(max(R**2 - level**2, 0.0)) < needed:
+        level += 0.25 * d
+    kept = np.empty((0, 3))
+    stalled = 0
+    for _ in range(max_rounds):
+        missing = n - len(kept)
+        if missing <= 0:
+            break
+        top = min(level, R)
+        m = CANDIDATES_PER_SPHERE * missing + 64
+        cand = np.column_stack([rng.uniform(-R, R, m), rng.uniform(-R, top, m),
+                                rng.uniform(0.0, length, m)])
+        cand = cand[_free(cand, case, clearance)]
+        if len(kept) and len(cand):
+            near = cKDTree(kept).query(cand, k=1, distance_upper_bound=gap)[0]
+            cand = cand[~np.isfinite(near)]
+        # Among themselves: keep a candidate unless an earlier one of this round is too near.
+        keep = np.ones(len(cand), dtype=bool)
+        for i, j in sorted(cKDTree(cand).query_pairs(gap)) if len(cand) > 1 else ():
+            if keep[i]:
+                keep[j] = False
+        added = cand[keep][:missing]
+        kept = np.vstack([kept, added])
+        stalled = stalled + 1 if len(added) < max(1.0, 0.01 * missing) else 0
+        if stalled >= STALLED_ROUNDS:
+            level, stalled = level + d, 0
+    if len(kept) < n:
+        raise InsertionError(n, len(kept), "random placement: use particles.placement = 'lattice', "
+                             "or fewer particles")
+    return kept[np.argsort(kept[:, 1], kind="stable")]
 
 
 def write_data_file(case: Case, positions: NDArray[np.float64], path: Path, box: tuple) -> None:

@@ -115,7 +115,9 @@ def scene_hash(case: Case) -> str:
     temperature, which both levels take.
     """
     dem = case.dem_case()
-    particles = dem.particles.model_copy(update={"interior": "lumped", "interior_shells": None})
+    # Nor is how the bed was first placed: a state replaces the placement.
+    particles = dem.particles.model_copy(update={"interior": "lumped", "interior_shells": None,
+                                                 "placement": "lattice"})
     return dem.model_copy(update={"particles": particles}).section_hash(*SCENE_SECTIONS)
 
 

@@ -110,10 +110,13 @@ SETUP: tuple[SetupChoice, ...] = (
     SetupChoice("air", "none", "the experiment is in air at rest; 3 mm glass beads at < 0.5 m/s "
                 "feel no drag worth modelling"),
     SetupChoice("time step", "drumflow 'auto'", "drumflow.dem.timestep"),
-    SetupChoice("initial bed", "drumflow's standard start: a face-centred-cubic lattice from the "
-                "bottom up (drumflow.dem.placement), the drum turning from t = 0",
-                "drumflow's placement, unchanged (recorded after the first small run, which "
-                "surged as a block: see the README's validation section)"),
+    SetupChoice("initial bed", "a loose random packing (particles.placement = 'random': random "
+                "sequential addition at solids fraction 0.3, drumflow.dem.placement) settling as "
+                "the drum turns from t = 0",
+                "the experiment's beads are poured, not stacked; drumflow's default lattice is a "
+                "crystal of equal spheres that, without lifters, rose with the shell as one block "
+                "and slid back (the first small run, 2026-11; see the validation page). Changed "
+                "for that reason before any comparison, not toward the measurement"),
     SetupChoice("end walls", "'small' and 'section': periodic section of 4 and 10 diameters; "
                 "'full': end walls turning with the shell (drum.ends = 'rotating'), averaged "
                 "over the middle |z - L/2| < 0.10 m", "a lab drum's end plates are fixed to its "
@@ -353,7 +356,7 @@ def rolling_drum_case(scale: str = "small") -> Case:
                     "thickness": 0.002},
         "particles": {"diameter": BEAD_DIAMETER, "density": BEAD_DENSITY, "youngs_modulus": 1.0e7,
                       "poisson_ratio": 0.24, "heat_capacity": 840.0, "conductivity": 1.0,
-                      "count": beads, "initial_temperature_C": 20.0},
+                      "count": beads, "initial_temperature_C": 20.0, "placement": "random"},
         "contacts": {"particle_particle": contact,
                      "particle_wall": {"restitution": 0.85, "friction": 0.35, "rolling_friction": 0.0},
                      "wall_youngs_modulus": 1.0e7},
