@@ -139,8 +139,9 @@ class Particles(_Section):
         description="initial bed: 'lattice', a face-centred-cubic lattice filled from the bottom "
         "(settles by a fraction of a diameter; the default); 'random', a loose random packing "
         "(random sequential addition, solids fraction about 0.3, seeded by run.seed) that "
-        "settles into a random bed. Equal spheres on a lattice keep their crystal in a drum "
-        "without lifters and move as a block (drumflow.dem.placement)",
+        "settles into a random bed, as a poured bed of equal beads lies; a lattice of equal "
+        "spheres is a crystal, which a drum without lifters does not break up quickly "
+        "(drumflow.dem.placement)",
     )
     interior_shells: int | None = Field(
         None, ge=2, le=40,

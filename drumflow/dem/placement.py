@@ -7,10 +7,9 @@ soft particles dropped from a lattice leak through a 3 m shell within 2,500 step
 placed near its rest position settles by only a fraction of a diameter. Writing positions to a
 LIGGGHTS data file also makes the count exact by construction.
 
-Equal spheres on a lattice are a crystal, and in a drum without lifters (a rolling drum of
-equal glass beads) the crystal survives: the bed rises with the shell as one block and slides
-back along it instead of rolling. ``particles.placement = "random"`` places them instead by
-random sequential addition (:func:`random_packing`): uniform random centres, each kept only if
+Equal spheres on a lattice are a crystal, which a drum without lifters does not break up
+quickly, while a poured bed of equal beads (a rolling-drum experiment) is random.
+``particles.placement = "random"`` places them instead by random sequential addition (:func:`random_packing`): uniform random centres, each kept only if
 it overlaps none kept before, at a loose solids fraction (:data:`RANDOM_SOLIDS_FRACTION`, below
 the 0.38 where addition jams) over the lowest part of the drum that holds them; the bed then
 settles into a random packing, each sphere falling at most about the loose bed's height.

@@ -113,10 +113,10 @@ SETUP: tuple[SetupChoice, ...] = (
     SetupChoice("initial bed", "a loose random packing (particles.placement = 'random': random "
                 "sequential addition at solids fraction 0.3, drumflow.dem.placement) settling as "
                 "the drum turns from t = 0",
-                "the experiment's beads are poured, not stacked; drumflow's default lattice is a "
-                "crystal of equal spheres that, without lifters, rose with the shell as one block "
-                "and slid back (the first small run, 2026-11; see the validation page). Changed "
-                "for that reason before any comparison, not toward the measurement"),
+                "the experiment's beads are poured, not stacked, and drumflow's default lattice is "
+                "a crystal of equal spheres; changed before any comparison, not toward the "
+                "measurement. (The small slice surged as a block from the lattice and again from "
+                "this bed: not the cause; see the validation page)"),
     SetupChoice("end walls", "'small' and 'section': periodic section of 4 and 10 diameters; "
                 "'full': end walls turning with the shell (drum.ends = 'rotating'), averaged "
                 "over the middle |z - L/2| < 0.10 m", "a lab drum's end plates are fixed to its "
