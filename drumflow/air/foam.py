@@ -11,6 +11,7 @@ from __future__ import annotations
 import math
 import shutil
 import time
+from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -99,6 +100,7 @@ def solve_air(
     processes: int = 1,
     timeout: float | None = 3600.0,
     on_iteration: IterationCallback | None = None,
+    prepare: Callable[[Path], None] | None = None,
 ) -> AirSolution:
     """Mesh, set up and solve the drum's steady air field; check mass flow and bulk velocity.
 
@@ -119,6 +121,9 @@ def solve_air(
         Limit for each program, s.
     on_iteration
         Progress callback, called with (iteration, initial residuals).
+    prepare
+        Called with ``workdir`` once the case is written, before the solver starts: to add to
+        the case (e.g. the bed's porosity zones of :mod:`drumflow.air.bed_air`).
 
     Returns
     -------
@@ -143,6 +148,8 @@ def solve_air(
             shutil.rmtree(p)
     mesh = build_air_mesh(case, workdir, runner, size=size, timeout=timeout)
     inputs = write_air_case(case, workdir, mesh, processes=processes)
+    if prepare is not None:
+        prepare(workdir)
 
     parser = ResidualParser(on_iteration)
     solver_started = time.time()

@@ -40,6 +40,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
+    from drumflow.air.solids_fraction import PorosityZones
     from drumflow.case import Case
 
 #: k-epsilon model constant C_mu (standard value) for the inlet epsilon.
@@ -350,6 +351,36 @@ def write_decompose_dict(case_dir: Path, processes: int, axis: int = 0) -> None:
         f["numberOfSubdomains"] = processes
         f["method"] = "simple"
         f["coeffs"] = {"n": n, "delta": 0.001}
+
+
+# -- porosity zones (drumflow.air.bed_air, drumflow.verify.porous_foam) ----------------
+
+def write_zone_sets(case_dir: Path, zones: PorosityZones) -> None:
+    """``system/topoSetDict``: one cellZoneSet per zone, from its cell list."""
+    from foamlib import FoamFile
+
+    topo = case_dir / "system" / "topoSetDict"
+    topo.unlink(missing_ok=True)
+    with FoamFile(topo) as f:
+        f["actions"] = [
+            {"name": name, "type": "cellZoneSet", "action": "new", "source": "labelToCell",
+             "value": [int(c) for c in cells]}
+            for name, cells in zip(zones.names, zones.cells, strict=True)
+        ]
+
+
+def darcy_forchheimer_coeffs(d: float, f: float) -> dict[str, Any]:
+    """The ``DarcyForchheimerCoeffs`` dictionary of isotropic coefficients d (1/m^2), f (1/m)."""
+    return {
+        "d": [float(d)] * 3,
+        "f": [float(f)] * 3,
+        "coordinateSystem": {
+            "type": "cartesian",
+            "origin": [0.0, 0.0, 0.0],
+            "coordinateRotation": {"type": "axesRotation", "e1": [1.0, 0.0, 0.0],
+                                   "e2": [0.0, 1.0, 0.0]},
+        },
+    }
 
 
 # -- the whole case ---------------------------------------------------------------------

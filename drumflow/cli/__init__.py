@@ -24,6 +24,7 @@ import typer
 
 from drumflow.cli import checks, models, results, run, studies
 from drumflow.cli._guard import console, err_console, guard_every_command
+from drumflow.cli.bed_air import bed_air
 from drumflow.cli.cooler import app as cooler_app
 from drumflow.cli.cooler.drum import drum as plant
 from drumflow.cli.export import export
@@ -48,7 +49,7 @@ _COMMANDS: dict[str, list[tuple[str, Callable[..., Any]]]] = {
     "Its results": [("report", results.report), ("paper", paper), ("export", export),
                     ("methodology", results.methodology), ("exchanger", results.exchanger)],
     "Models": [("plant", plant), ("predict", models.predict)],
-    "Studies": [("sweep", studies.sweep), ("validate", studies.validate)],
+    "Studies": [("sweep", studies.sweep), ("validate", studies.validate), ("bed-air", bed_air)],
     "Checks and speed": [("verify", checks.verify), ("bench", checks.bench),
                          ("ladder", checks.ladder), ("answer", checks.answer),
                          ("profile", checks.profile)],

@@ -9,10 +9,11 @@ LIGGGHTS data file also makes the count exact by construction.
 
 Equal spheres on a lattice are a crystal, which a drum without lifters does not break up
 quickly, while a poured bed of equal beads (a rolling-drum experiment) is random.
-``particles.placement = "random"`` places them instead by random sequential addition (:func:`random_packing`): uniform random centres, each kept only if
-it overlaps none kept before, at a loose solids fraction (:data:`RANDOM_SOLIDS_FRACTION`, below
-the 0.38 where addition jams) over the lowest part of the drum that holds them; the bed then
-settles into a random packing, each sphere falling at most about the loose bed's height.
+``particles.placement = "random"`` places them instead by random sequential addition
+(:func:`random_packing`): uniform random centres, each kept only if it overlaps none kept
+before, at a loose solids fraction (:data:`RANDOM_SOLIDS_FRACTION`, below the 0.38 where
+addition jams) over the lowest part of the drum that holds them; the bed then settles into a
+random packing, each sphere falling at most about the loose bed's height.
 """
 
 from __future__ import annotations

@@ -17,6 +17,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from drumflow.air.foam_case import darcy_forchheimer_coeffs, write_zone_sets
 from drumflow.air.solids_fraction import PorosityZones
 from drumflow.errors import AirNotConvergedError
 from drumflow.runner import Runner
@@ -25,11 +26,13 @@ __all__ = [
     "AirOfBed",
     "air_at",
     "cell_order",
+    "darcy_forchheimer_coeffs",
     "fresh_case",
     "solve_bed_air",
     "write_block_mesh",
     "write_numerics",
     "write_porosity",
+    "write_zone_sets",
 ]
 
 #: Air at 30 C and 1 atm (drumflow's air table).
@@ -121,14 +124,7 @@ def write_porosity(case_dir: Path, zones: PorosityZones) -> None:
     ``constant/porosityProperties`` (one DarcyForchheimer model per zone)."""
     from foamlib import FoamFile
 
-    topo = case_dir / "system" / "topoSetDict"
-    topo.unlink(missing_ok=True)
-    with FoamFile(topo) as f:
-        f["actions"] = [
-            {"name": name, "type": "cellZoneSet", "action": "new", "source": "labelToCell",
-             "value": [int(c) for c in cells]}
-            for name, cells in zip(zones.names, zones.cells, strict=True)
-        ]
+    write_zone_sets(case_dir, zones)
     props = case_dir / "constant" / "porosityProperties"
     props.unlink(missing_ok=True)
     with FoamFile(props) as f:
@@ -137,16 +133,7 @@ def write_porosity(case_dir: Path, zones: PorosityZones) -> None:
                 "type": "DarcyForchheimer",
                 "active": True,
                 "cellZone": name,
-                "DarcyForchheimerCoeffs": {
-                    "d": [float(d)] * 3,
-                    "f": [float(fc)] * 3,
-                    "coordinateSystem": {
-                        "type": "cartesian",
-                        "origin": [0.0, 0.0, 0.0],
-                        "coordinateRotation": {"type": "axesRotation", "e1": [1.0, 0.0, 0.0],
-                                               "e2": [0.0, 1.0, 0.0]},
-                    },
-                },
+                "DarcyForchheimerCoeffs": darcy_forchheimer_coeffs(float(d), float(fc)),
             }
 
 

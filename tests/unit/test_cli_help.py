@@ -17,7 +17,7 @@ EXPECTED = {
     "A run": ["check", "run", "status", "stop", "post"],
     "Its results": ["report", "paper", "export", "methodology", "exchanger"],
     "Models": ["plant", "predict", "cooler"],
-    "Studies": ["sweep", "validate"],
+    "Studies": ["sweep", "validate", "bed-air"],
     "Checks and speed": ["verify", "bench", "ladder", "answer", "profile"],
 }
 

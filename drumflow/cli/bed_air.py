@@ -1,0 +1,87 @@
+"""`drumflow bed-air CASE --state STATE.npz --out DIR`: the drum's air solved once with a bed
+state's particles as Ergun porosity, beside the empty drum's, and what the bed and the curtains
+do to it (:mod:`drumflow.air.bed_air`).
+
+Exit codes (:func:`drumflow.errors.exit_code`): 0 written, 1 OpenFOAM failed or did not
+converge, 2 bad input (case file, a state of another scene, a grid spacing out of range), 130
+interrupted. Bad input is refused before any solver starts.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Annotated, Optional
+
+import typer
+from rich.table import Table
+
+from drumflow.cli._common import load_case_file
+from drumflow.cli._guard import console, err_console
+
+__all__ = ["bed_air"]
+
+#: Where the two OpenFOAM cases go unless ``--work`` says otherwise.
+DEFAULT_WORK = Path("/var/tmp/drumflow-runs/bed_air")
+
+
+def bed_air(
+    case_file: Annotated[Path, typer.Argument(help="case file (TOML) the state belongs to")],
+    state_file: Annotated[Path, typer.Option("--state", help="bed state (.npz, `drumflow export "
+                                             "RUN --state`)")],
+    out: Annotated[Path, typer.Option("--out", help="folder for split.json, split.csv and the "
+                                      "cross-section picture")],
+    grid_spacing: Annotated[Optional[float], typer.Option(
+        "--grid-spacing", help="deposition grid size, m (default: the larger of two parcel "
+        "diameters and the air mesh size)")] = None,
+    processes: Annotated[int, typer.Option("--processes", help="MPI ranks for simpleFoam")] = 1,
+    work: Annotated[Optional[Path], typer.Option(
+        "--work", help="where the OpenFOAM cases go (default /var/tmp/drumflow-runs/bed_air/"
+        "<out folder name>)")] = None,
+) -> None:
+    """Solve the drum's air with a bed state's particles as porosity (Ergun), once, and
+    measure the through-flow of bed, curtains and free air against the empty drum."""
+    from drumflow.air.bed_air import CATEGORIES, solve_bed_air, write_bed_air
+    from drumflow.dem.state import check_state, read_state
+    from drumflow.errors import AnalysisInputError
+    from drumflow.geometry.fluid import fluid_mesh_size
+    from drumflow.runner import Runner
+
+    case = load_case_file(case_file)
+    state = read_state(state_file)
+    check_state(state, case, state_file)
+    if case.air.model != "cfd":
+        raise AnalysisInputError(f"{case_file}: air.model", case.air.model, "'cfd'")
+    if grid_spacing is not None:
+        top = 0.5 * min(case.drum.diameter, case.drum.length)
+        low = fluid_mesh_size(case) / 4.0
+        if not (math.isfinite(grid_spacing) and low <= grid_spacing <= top):
+            raise AnalysisInputError("--grid-spacing", grid_spacing,
+                                     f"a length from {low:.4g} m (a quarter of the mesh size) to "
+                                     f"{top:.4g} m (half the drum's smaller extent)")
+    if not 1 <= processes <= 256:
+        raise AnalysisInputError("--processes", processes, "an integer from 1 to 256")
+    workdir = work or DEFAULT_WORK / out.resolve().name
+    err_console.print(f"solving the empty drum and the bed in {workdir} ...", highlight=False)
+    result = solve_bed_air(case, state, workdir, Runner(), spacing=grid_spacing,
+                           processes=processes)
+    paths = write_bed_air(result, out)
+    table = Table(title=f"{case.name}: air around the bed (state t = {result.state['time_s']:.3f} s)")
+    for col in ("", "cells", "axial flow empty", "axial flow bed", "|U| empty", "|U| bed"):
+        table.add_column(col, justify="left" if col == "" else "right")
+    e, b = result.empty, result.bed
+    for name in CATEGORIES:
+        table.add_row(name, f"{result.category_cells[name]:,}",
+                      f"{e.axial_flow_m3_s[name]:.4g} m3/s", f"{b.axial_flow_m3_s[name]:.4g} m3/s",
+                      f"{e.mean_speed_m_s[name]:.3g} m/s", f"{b.mean_speed_m_s[name]:.3g} m/s")
+    table.add_row("total", f"{result.cells:,}", f"{e.axial_flow_m3_s['total']:.4g} m3/s",
+                  f"{b.axial_flow_m3_s['total']:.4g} m3/s", "", "")
+    console.print(table)
+    console.print(
+        f"into the curtains from free air: {e.inflow_m3_s_m['curtain_from_free']:.4g} (empty) -> "
+        f"{b.inflow_m3_s_m['curtain_from_free']:.4g} m3/s/m (bed); into the bed: "
+        f"{e.inflow_m3_s_m['bed_from_other']:.4g} -> {b.inflow_m3_s_m['bed_from_other']:.4g} "
+        f"m3/s/m\npressure drop {e.pressure_drop_Pa:.4g} Pa (empty) -> {b.pressure_drop_Pa:.4g} "
+        f"Pa (bed); solids on the cells {100 * result.deposit['cells_over_particles']:.2f} % of "
+        f"the particles'; wall time {result.wall_time_s:.0f} s", highlight=False)
+    console.print("written: " + ", ".join(str(p) for p in paths), highlight=False)
