@@ -441,7 +441,7 @@ def ladder(
         table.add_row(*cells)
     console.print(table)
     floor = ", ".join(f"{q} ±{result.noise_floor[q]:.2%}" for q in answers)
-    console.print(f"noise floor (the reference's batch-means half-widths): {floor}; "
+    console.print(f"noise floor (the reference's half-widths): {floor}; "
                   "* wall time estimated (scaled or partly from a rate)", highlight=False)
     for _, row in result.table.iterrows():
         console.print(f"{row['rung']}: {row['note']}", highlight=False)
