@@ -113,6 +113,9 @@ def falling_mass_flow(
 ) -> FallingMassFlow:
     """The paper's falling mass flow (Eq. 57) from a crossing table.
 
+    With an ``in_contact`` column known for every crossing of the window, the flow is also
+    split into the airborne part (no particle contact at the crossing) and the bed's.
+
     Parameters
     ----------
     crossings
@@ -125,9 +128,6 @@ def falling_mass_flow(
     curtain_radius
         If given, also the mass flow of crossings with |x| below it (the falling curtain,
         without particles carried down by the lifters along the wall).
-
-    With an ``in_contact`` column known for every crossing of the window, the flow is also
-    split into the airborne part (no particle contact at the crossing) and the bed's.
 
     Returns
     -------
