@@ -40,11 +40,12 @@ import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Protocol
+from typing import TYPE_CHECKING, Any, Literal, Protocol
 
 import numpy as np
 from numpy.typing import NDArray
 
+from drumflow.air.poly_mesh import PolyMesh, read_poly_mesh
 from drumflow.air.solids_fraction import (
     ERGUN,
     ErgunLaw,
@@ -76,6 +77,14 @@ ZONE_DECADES = (POROUS_FRACTION, 0.01, 0.1, BED_FRACTION, 1.0)
 #: 1-2-1 smoothing passes per axis of the deposition.
 SMOOTHING_PASSES = 1
 CATEGORIES = ("bed", "curtain", "free")
+#: How the air meets the slice's ends: a piece of a long drum (:mod:`drumflow.air.periodic`,
+#: the plant's question) or the case's inlet and outlet (the paper's set-up).
+Axial = Literal["periodic", "inlet-outlet"]
+AXIAL_MODES: tuple[str, ...] = ("periodic", "inlet-outlet")
+#: SIMPLE iteration limit of the periodic solves when the case allows fewer: periodic air
+#: converges slowly (the smoke drum's bed case took 1,672 iterations to 1e-4, the inlet-outlet
+#: one 538; docs/air-around-the-bed.md), and stopping early is not an option.
+PERIODIC_MAX_ITERATIONS = 6000
 _FIELDS = ("U", "p", "k", "epsilon", "nut")
 
 
@@ -93,66 +102,6 @@ class BedSnapshot(Protocol):
     @property
     def source(self) -> str: ...
     def __len__(self) -> int: ...
-
-
-@dataclass(frozen=True)
-class PolyMesh:
-    """The parts of an OpenFOAM polyMesh the measurements need.
-
-    ``owner`` of every face, ``neighbour`` of the internal ones (the first faces); per face its
-    centre (m) and area vector (m^2, out of the owner); ``patches``: name -> (start face,
-    count); ``bounds``: the lower and upper corner of the mesh points, m.
-    """
-
-    owner: NDArray[np.int64]
-    neighbour: NDArray[np.int64]
-    face_centres: NDArray[np.float64]
-    face_areas: NDArray[np.float64]
-    patches: dict[str, tuple[int, int]]
-    bounds: tuple[NDArray[np.float64], NDArray[np.float64]]
-
-    def patch_faces(self, name: str) -> slice:
-        start, count = self.patches[name]
-        return slice(start, start + count)
-
-
-def read_poly_mesh(case_dir: Path) -> PolyMesh:
-    """Read ``constant/polyMesh`` (ascii) and compute the face centres and area vectors.
-
-    Faces are split into triangles fanned about their mean point; the area vector is the sum
-    of the triangles', the centre their area-weighted mean (exact for the triangles of a
-    tetrahedral mesh).
-    """
-    from foamlib import FoamFile
-
-    poly = case_dir / "constant" / "polyMesh"
-    points = np.asarray(FoamFile(poly / "points")[None], dtype=float).reshape(-1, 3)
-    owner = np.asarray(FoamFile(poly / "owner")[None], dtype=np.int64).ravel()
-    neighbour = np.asarray(FoamFile(poly / "neighbour")[None], dtype=np.int64).ravel()
-    faces: Any = FoamFile(poly / "faces")[None]
-    sizes = np.array([len(f) for f in faces])
-    centres = np.zeros((len(faces), 3))
-    areas = np.zeros((len(faces), 3))
-    for size in np.unique(sizes):
-        which = np.flatnonzero(sizes == size)
-        verts = points[np.array([np.asarray(faces[i], dtype=np.int64) for i in which])]
-        mid = verts.mean(axis=1)
-        a = np.zeros((len(which), 3))
-        weighted = np.zeros((len(which), 3))
-        total = np.zeros(len(which))
-        for j in range(size):
-            p0, p1 = verts[:, j], verts[:, (j + 1) % size]
-            tri = 0.5 * np.cross(p0 - mid, p1 - mid)
-            a += tri
-            w = np.linalg.norm(tri, axis=1)
-            weighted += w[:, None] * (p0 + p1 + mid) / 3.0
-            total += w
-        areas[which] = a
-        centres[which] = weighted / np.maximum(total, 1e-300)[:, None]
-    boundary: Any = FoamFile(poly / "boundary")[None]
-    patches = {str(name): (int(p["startFace"]), int(p["nFaces"])) for name, p in boundary}
-    return PolyMesh(owner, neighbour, centres, areas, patches,
-                    (points.min(axis=0), points.max(axis=0)))
 
 
 @dataclass(frozen=True)
@@ -314,6 +263,7 @@ class AirMeasure:
     inflow_drum_frame_m3_s_m: dict[str, float]
     mean_speed_m_s: dict[str, float]
     pressure_drop_Pa: float
+    pressure_gradient_Pa_m: float
     inlet_flow_m3_s: float
     iterations: int
     wall_time_s: float
@@ -328,8 +278,11 @@ def _patch_mean(mesh: PolyMesh, values: NDArray[np.float64], cells: NDArray[np.f
 
 
 def measure_air(case_dir: Path, time_dir: str, mesh: PolyMesh, category: NDArray[np.int64],
-                omega: float, density: float, iterations: int, wall_time_s: float) -> AirMeasure:
-    """Read one solution (U, p, phi, cell volumes) and measure it (module docstring)."""
+                omega: float, density: float, iterations: int, wall_time_s: float,
+                periodic: bool = False) -> AirMeasure:
+    """Read one solution (U, p, phi, cell volumes) and measure it (module docstring). The
+    pressure drop over the slice: the inlet-outlet difference, or periodic the gradient that
+    ``meanVelocityForce`` applied times the slice's length."""
     from foamlib import FoamFieldFile
 
     from drumflow.air.foam_results import patch_flux, read_cell_fields
@@ -355,12 +308,17 @@ def measure_air(case_dir: Path, time_dir: str, mesh: PolyMesh, category: NDArray
     speed = np.linalg.norm(cells["U"], axis=1)
     mean = {name: float(np.average(speed[m], weights=cells["V"][m])) if m.any() else float("nan")
             for name, m in masks.items()}
-    boundary: Any = FoamFieldFile(case_dir / time_dir / "p").boundary_field
-    p_face = {name: np.asarray(boundary[name].get("value", []), float).ravel()
-              for name in ("inlet", "outlet")}
-    drop = density * (_patch_mean(mesh, p_face["inlet"], cells["p"], "inlet")
-                      - _patch_mean(mesh, p_face["outlet"], cells["p"], "outlet"))
-    return AirMeasure(flows, inflows["absolute"], inflows["drum"], mean, drop,
+    if periodic:
+        from drumflow.air.periodic import read_pressure_gradient
+
+        drop = density * read_pressure_gradient(case_dir, time_dir) * length
+    else:
+        boundary: Any = FoamFieldFile(case_dir / time_dir / "p").boundary_field
+        p_face = {name: np.asarray(boundary[name].get("value", []), float).ravel()
+                  for name in ("inlet", "outlet")}
+        drop = density * (_patch_mean(mesh, p_face["inlet"], cells["p"], "inlet")
+                          - _patch_mean(mesh, p_face["outlet"], cells["p"], "outlet"))
+    return AirMeasure(flows, inflows["absolute"], inflows["drum"], mean, drop, drop / length,
                       -patch_flux(case_dir, time_dir, "inlet"), iterations, wall_time_s)
 
 
@@ -369,6 +327,7 @@ class BedAirResult:
     """Empty and bed air of one state on the same mesh, and how the bed was made."""
 
     case_name: str
+    axial: str
     state: dict[str, Any]
     cells: int
     category_cells: dict[str, int]
@@ -397,7 +356,8 @@ class BedAirResult:
                     ("inflow", "m3/s/m", m.inflow_m3_s_m),
                     ("inflow_drum_frame", "m3/s/m", m.inflow_drum_frame_m3_s_m),
                     ("mean_speed", "m/s", m.mean_speed_m_s),
-                    ("pressure_drop", "Pa", {"inlet_outlet": m.pressure_drop_Pa})):
+                    ("pressure_drop", "Pa", {"over_slice": m.pressure_drop_Pa}),
+                    ("pressure_gradient", "Pa/m", {"axial": m.pressure_gradient_Pa_m})):
                 rows += [{"solution": label, "quantity": quantity, "part": k, "value": v,
                           "unit": unit} for k, v in values.items()]
         return rows
@@ -466,6 +426,7 @@ def solve_bed_air(
     processes: int = 1,
     timeout: float | None = 7200.0,
     law: ErgunLaw = ERGUN,
+    axial: Axial = "periodic",
 ) -> BedAirResult:
     """Solve the drum's air empty and with ``state``'s particles as porosity; measure both.
 
@@ -481,6 +442,10 @@ def solve_bed_air(
         mesh size); the Ergun constants.
     processes, timeout
         MPI ranks for simpleFoam; limit per OpenFOAM program, s.
+    axial
+        ``"periodic"`` (default): the slice as a piece of a long drum at the case's mean air
+        velocity (:mod:`drumflow.air.periodic`; at least :data:`PERIODIC_MAX_ITERATIONS`
+        SIMPLE iterations allowed); ``"inlet-outlet"``: the case's own ends.
 
     Raises
     ------
@@ -497,9 +462,16 @@ def solve_bed_air(
     from drumflow.geometry.fluid import fluid_mesh_size
     from drumflow.physics.drum_frame import rotate_to_drum_frame
 
+    if axial not in AXIAL_MODES:
+        raise AnalysisInputError("axial", axial, f"one of {', '.join(AXIAL_MODES)}")
+    periodic = axial == "periodic"
+    if periodic and case.air.max_iterations < PERIODIC_MAX_ITERATIONS:
+        case = case.model_copy(update={"air": case.air.model_copy(
+            update={"max_iterations": PERIODIC_MAX_ITERATIONS})})
     t0 = time.perf_counter()
     workdir = Path(workdir)
-    empty = solve_air(case, workdir / "empty", runner, processes=processes, timeout=timeout)
+    empty = solve_air(case, workdir / "empty", runner, processes=processes, timeout=timeout,
+                      periodic=periodic)
     mesh = read_poly_mesh(empty.case_dir)
     cells = read_cell_fields(empty.case_dir, empty.time_dir)
     h = spacing if spacing is not None else max(4.0 * float(state.radii.max()),
@@ -530,13 +502,14 @@ def solve_bed_air(
         run_foam(runner, "topoSet", [], bed_dir, timeout=timeout)
 
     bed = solve_air(case, workdir / "bed", runner, processes=processes, timeout=timeout,
-                    prepare=prepare)
+                    prepare=prepare, periodic=periodic)
     category = categorize(deposit.fraction)
     measures = [measure_air(s.case_dir, s.time_dir, mesh, category, case.drum.omega, rho,
-                            s.iterations, s.wall_time_s) for s in (empty, bed)]
+                            s.iterations, s.wall_time_s, periodic) for s in (empty, bed)]
     bed_cells = read_cell_fields(bed.case_dir, bed.time_dir)
     return BedAirResult(
         case_name=case.name,
+        axial=axial,
         state={"time_s": state.time_s, "drum_angle_rad": state.drum_angle_rad,
                "particles": len(state), "parcel_diameter_m": 2.0 * float(state.radii.max()),
                "source": state.source},

@@ -101,6 +101,7 @@ def solve_air(
     timeout: float | None = 3600.0,
     on_iteration: IterationCallback | None = None,
     prepare: Callable[[Path], None] | None = None,
+    periodic: bool = False,
 ) -> AirSolution:
     """Mesh, set up and solve the drum's steady air field; check mass flow and bulk velocity.
 
@@ -124,6 +125,9 @@ def solve_air(
     prepare
         Called with ``workdir`` once the case is written, before the solver starts: to add to
         the case (e.g. the bed's porosity zones of :mod:`drumflow.air.bed_air`).
+    periodic
+        The slice as a piece of a long drum: its ends coupled and the flow held at the case's
+        mean velocity (:mod:`drumflow.air.periodic`) instead of an inlet and an outlet.
 
     Returns
     -------
@@ -146,10 +150,14 @@ def solve_air(
         if p.is_dir() and (_is_time(p.name) or p.name.startswith("processor")
                            or p.name == "postProcessing"):
             shutil.rmtree(p)
-    mesh = build_air_mesh(case, workdir, runner, size=size, timeout=timeout)
+    mesh = build_air_mesh(case, workdir, runner, size=size, timeout=timeout, periodic=periodic)
     inputs = write_air_case(case, workdir, mesh, processes=processes)
     if prepare is not None:
         prepare(workdir)
+    if periodic:
+        from drumflow.air.periodic import make_periodic
+
+        make_periodic(workdir, case.drum.length, float(inputs["bulk_velocity"]))
 
     parser = ResidualParser(on_iteration)
     solver_started = time.time()

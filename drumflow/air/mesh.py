@@ -206,6 +206,7 @@ def build_air_mesh(
     runner: Runner,
     size: float | None = None,
     timeout: float | None = 600,
+    periodic: bool = False,
 ) -> dict[str, Any]:
     """Mesh the drum's fluid with gmsh and turn it into a checked OpenFOAM polyMesh.
 
@@ -219,6 +220,8 @@ def build_air_mesh(
         Starts gmshToFoam and checkMesh.
     size
         Bulk cell size, m; default ``air.mesh_size`` ('auto' = D/20).
+    periodic
+        End faces meshed alike, to be coupled (:mod:`drumflow.air.periodic`).
 
     Returns
     -------
@@ -230,7 +233,7 @@ def build_air_mesh(
 
     case_dir.mkdir(parents=True, exist_ok=True)
     msh = case_dir / "fluid.msh"
-    info = write_fluid_mesh(case, msh, size=size)
+    info = write_fluid_mesh(case, msh, size=size, periodic=periodic)
     info["patches"] = import_gmsh_mesh(msh, case_dir, runner, {"walls": "wall"}, timeout=timeout)
     info["check"] = check_mesh(case_dir, runner, timeout=timeout)
     return info

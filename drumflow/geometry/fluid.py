@@ -83,7 +83,8 @@ def cross_section_properties(case: Case) -> dict[str, float]:
     }
 
 
-def write_fluid_mesh(case: Case, path: Path, size: float | None = None) -> dict[str, Any]:
+def write_fluid_mesh(case: Case, path: Path, size: float | None = None,
+                     periodic: bool = False) -> dict[str, Any]:
     """Mesh the fluid volume of the section with tetrahedra and write it as ASCII msh 2.2.
 
     Parameters
@@ -95,6 +96,10 @@ def write_fluid_mesh(case: Case, path: Path, size: float | None = None) -> dict[
     size
         Bulk cell size, m; default :func:`fluid_mesh_size`. The walls get
         ``WALL_SIZE_FRACTION * size``.
+    periodic
+        Mesh the inlet face as a copy of the outlet face moved by the section length (gmsh
+        ``setPeriodic``), so that the two can be coupled face to face
+        (:mod:`drumflow.air.periodic`).
 
     Returns
     -------
@@ -146,6 +151,11 @@ def write_fluid_mesh(case: Case, path: Path, size: float | None = None) -> dict[
         for name, tags in groups.items():
             gmsh.model.addPhysicalGroup(2, tags, name=name)
         gmsh.model.addPhysicalGroup(3, volumes, name="fluid")
+        if periodic:
+            # The inlet (z = l) takes the outlet's (z = 0) surface mesh, moved by l along z.
+            shift = [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, length,
+                     0.0, 0.0, 0.0, 1.0]
+            gmsh.model.mesh.setPeriodic(2, groups["inlet"], groups["outlet"], shift)
 
         # Finer cells at the walls through a distance field (no prism layers, see above).
         mf = gmsh.model.mesh.field

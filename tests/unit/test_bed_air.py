@@ -140,6 +140,8 @@ ROOT = Path(__file__).resolve().parents[2]
     (["cases/smoke.toml", "--state", "results/states/smoke_1.0s.npz", "--grid-spacing", "-0.1"],
      "--grid-spacing = -0.1"),
     (["cases/smoke.toml", "--state", "results/states/no_such_state.npz"], "no_such_state.npz"),
+    (["cases/smoke.toml", "--state", "results/states/smoke_1.0s.npz", "--axial", "cyclic"],
+     "--axial = cyclic"),
 ])
 def test_bad_input_is_refused_before_any_solver(tmp_path: Path, args: list[str],
                                                 named: str) -> None:
@@ -152,3 +154,19 @@ def test_bad_input_is_refused_before_any_solver(tmp_path: Path, args: list[str],
     assert named in done.stderr
     assert "Traceback" not in done.stderr
     assert not out.exists() and not (tmp_path / "work").exists()
+
+
+def test_a_case_without_a_periodic_gradient_is_refused_by_name(tmp_path: Path) -> None:
+    """The periodic pressure gradient is read from the solution or the solver log; a case that
+    was not periodic has neither, and the error names where it looked."""
+    from drumflow.air.periodic import read_pressure_gradient
+    from drumflow.errors import SolverError
+
+    (tmp_path / "5").mkdir()
+    (tmp_path / "log.simpleFoam").write_text("Time = 5\nSIMPLE solution converged in 5 iterations\n")
+    with pytest.raises(SolverError, match="no meanVelocityForce gradient"):
+        read_pressure_gradient(tmp_path, "5")
+    (tmp_path / "log.simpleFoam").write_text(
+        "Pressure gradient source: uncorrected Ubar = 3.05, pressure gradient = 0.25\n"
+        "Pressure gradient source: uncorrected Ubar = 3.054, pressure gradient = 0.2007\n")
+    assert read_pressure_gradient(tmp_path, "5") == pytest.approx(0.2007)
