@@ -1,23 +1,29 @@
-"""`drumflow bed-air CASE --state STATE.npz --out DIR`: the drum's air solved once with a bed
-state's particles as Ergun porosity, beside the empty drum's, and what the bed and the curtains
-do to it (:mod:`drumflow.air.bed_air`).
+"""`drumflow bed-air CASE --state STATE.npz --out DIR [--heat]`: the drum's air solved once with
+a bed state's particles as Ergun porosity, beside the empty drum's, and what the bed and the
+curtains do to it (:mod:`drumflow.air.bed_air`); with ``--heat`` also the air's temperature
+with the particles' heat, and the contact efficiency (:mod:`drumflow.air.bed_heat`).
 
 Exit codes (:func:`drumflow.errors.exit_code`): 0 written, 1 OpenFOAM failed or did not
-converge, 2 bad input (case file, a state of another scene, a grid spacing out of range), 130
+converge, 2 bad input (case file, a state of another scene, a grid spacing out of range, an
+unknown ``--axial``), 130
 interrupted. Bad input is refused before any solver starts.
 """
 
 from __future__ import annotations
 
+import json
 import math
 from pathlib import Path
-from typing import Annotated, Optional
+from typing import TYPE_CHECKING, Annotated, Optional
 
 import typer
 from rich.table import Table
 
 from drumflow.cli._common import load_case_file
 from drumflow.cli._guard import console, err_console
+
+if TYPE_CHECKING:
+    from drumflow.air.bed_air import BedAirResult
 
 __all__ = ["bed_air"]
 
@@ -35,13 +41,20 @@ def bed_air(
         "--grid-spacing", help="deposition grid size, m (default: the larger of two parcel "
         "diameters and the air mesh size)")] = None,
     processes: Annotated[int, typer.Option("--processes", help="MPI ranks for simpleFoam")] = 1,
+    axial: Annotated[str, typer.Option("--axial", help="periodic: the slice as a piece of a long "
+                                       "drum at the case's mean air velocity (the plant's "
+                                       "question); inlet-outlet: the case's own ends")
+                     ] = "periodic",
+    heat: Annotated[bool, typer.Option("--heat", help="also solve the air's temperature with "
+                                       "the particles' heat (Gunn) and write heat.json: the "
+                                       "contact efficiency")] = False,
     work: Annotated[Optional[Path], typer.Option(
         "--work", help="where the OpenFOAM cases go (default /var/tmp/drumflow-runs/bed_air/"
         "<out folder name>)")] = None,
 ) -> None:
     """Solve the drum's air with a bed state's particles as porosity (Ergun), once, and
     measure the through-flow of bed, curtains and free air against the empty drum."""
-    from drumflow.air.bed_air import CATEGORIES, solve_bed_air, write_bed_air
+    from drumflow.air.bed_air import AXIAL_MODES, solve_bed_air, write_bed_air
     from drumflow.dem.state import check_state, read_state
     from drumflow.errors import AnalysisInputError
     from drumflow.geometry.fluid import fluid_mesh_size
@@ -61,12 +74,35 @@ def bed_air(
                                      f"{top:.4g} m (half the drum's smaller extent)")
     if not 1 <= processes <= 256:
         raise AnalysisInputError("--processes", processes, "an integer from 1 to 256")
+    if axial not in AXIAL_MODES:
+        raise AnalysisInputError("--axial", axial, " or ".join(AXIAL_MODES))
     workdir = work or DEFAULT_WORK / out.resolve().name
     err_console.print(f"solving the empty drum and the bed in {workdir} ...", highlight=False)
     result = solve_bed_air(case, state, workdir, Runner(), spacing=grid_spacing,
-                           processes=processes)
-    paths = write_bed_air(result, out)
-    table = Table(title=f"{case.name}: air around the bed (state t = {result.state['time_s']:.3f} s)")
+                           processes=processes, axial=axial)  # type: ignore[arg-type]
+    paths = list(write_bed_air(result, out))
+    _print_split(result, case.name, axial)
+    if heat:
+        from drumflow.air.bed_heat import solve_bed_heat
+
+        err_console.print("solving the air's temperature with the particles' heat ...",
+                          highlight=False)
+        warm = solve_bed_heat(result, state, case, Runner(), workdir, spacing=grid_spacing)
+        paths.append(out / "heat.json")
+        paths[-1].write_text(json.dumps(warm.as_dict(), indent=2, default=float) + "\n")
+        console.print(
+            f"heat taken by the air {warm.heat_W / 1e3:.4g} kW of {warm.heat_bulk_W / 1e3:.4g} kW "
+            f"with fresh air everywhere: contact efficiency {warm.contact_efficiency:.3f}; air "
+            f"{warm.air_inlet_temperature_C:.1f} -> {warm.air_outlet_temperature_C:.2f} C; as "
+            f"saturated air {warm.saturated_flow_m3_s_m:.3g} m3/s per metre", highlight=False)
+    console.print("written: " + ", ".join(str(p) for p in paths), highlight=False)
+
+
+def _print_split(result: BedAirResult, case_name: str, axial: str) -> None:
+    from drumflow.air.bed_air import CATEGORIES
+
+    table = Table(title=f"{case_name}: air around the bed (state t = {result.state['time_s']:.3f} "
+                  f"s, {axial} air)")
     for col in ("", "cells", "axial flow empty", "axial flow bed", "|U| empty", "|U| bed"):
         table.add_column(col, justify="left" if col == "" else "right")
     e, b = result.empty, result.bed
@@ -84,4 +120,3 @@ def bed_air(
         f"m3/s/m\npressure drop {e.pressure_drop_Pa:.4g} Pa (empty) -> {b.pressure_drop_Pa:.4g} "
         f"Pa (bed); solids on the cells {100 * result.deposit['cells_over_particles']:.2f} % of "
         f"the particles'; wall time {result.wall_time_s:.0f} s", highlight=False)
-    console.print("written: " + ", ".join(str(p) for p in paths), highlight=False)

@@ -354,15 +354,9 @@ def particle_reynolds(velocity: float, diameter: float, gas: HumidAir) -> float:
 
 
 def gunn_nusselt(reynolds: float, prandtl: float, voidage: float) -> float:
-    """Gunn (1978) gas-particle Nusselt number in fixed and fluidised beds:
+    """Gunn (1978) gas-particle Nusselt number in fixed and fluidised beds, for one bed: the
+    law lives once, in :func:`drumflow.physics.particle_air.gunn_nusselt` (0.35 <= eps <= 1,
+    Re on the superficial velocity; a voidage outside raises a ``ValueError``)."""
+    from drumflow.physics.particle_air import gunn_nusselt as law
 
-    Nu = (7 - 10 eps + 5 eps^2)(1 + 0.7 Re^0.2 Pr^(1/3))
-         + (1.33 - 2.4 eps + 1.2 eps^2) Re^0.7 Pr^(1/3),
-
-    for 0.35 <= eps <= 1 and Re <= 1e5 (Re on the superficial velocity).
-    """
-    if not 0.35 <= voidage <= 1.0:
-        raise ValueError(f"voidage {voidage:.3g} outside Gunn's range 0.35..1")
-    pr3 = prandtl ** (1.0 / 3.0)
-    return ((7.0 - 10.0 * voidage + 5.0 * voidage**2) * (1.0 + 0.7 * reynolds**0.2 * pr3)
-            + (1.33 - 2.4 * voidage + 1.2 * voidage**2) * reynolds**0.7 * pr3)
+    return float(law(reynolds, prandtl, voidage))

@@ -1,4 +1,4 @@
-"""Air acting on particles: drag (Schiller-Naumann) and convection (Ranz-Marshall).
+"""Air acting on particles: drag (Schiller-Naumann) and convection (Ranz-Marshall; Gunn in beds).
 
 Physics only, vectorised over particles and free of any solver, so it is unit-tested against
 closed forms. The same functions give the analytic references of the verification cases
@@ -7,7 +7,8 @@ closed forms. The same functions give the analytic references of the verificatio
 Equations of Burgos-Florez et al. (2019): drag F_d = 1/2 C_d rho A_p |V_s| V_s (Eq. 3) with the
 Schiller-Naumann C_d; pressure-gradient force F_p = -V_p grad p (Eq. 4); convective heat
 Q = h A_s (T - T_p) (Eq. 21) with Nu = h D_p / k_f (Eq. 22) = 2 (1 + 0.3 Re^0.5 Pr^(1/3))
-(Eq. 23, Ranz-Marshall).
+(Eq. 23, Ranz-Marshall). Among many particles (a bed, a dense curtain): Gunn's (1978) Nusselt
+number at the local voidage (:func:`gunn_nusselt`, :func:`gunn_h`).
 """
 
 from __future__ import annotations
@@ -113,6 +114,57 @@ def convective_heat(
     d = np.broadcast_to(np.asarray(diameter, float), slip.shape)
     h = ranz_marshall_h(slip, d, air)
     return h * math.pi * d**2 * (air.temperature_C - np.asarray(particle_temperature, float))
+
+
+#: Voidage range of Gunn's (1978) correlation.
+GUNN_VOIDAGE = (0.35, 1.0)
+
+
+def gunn_nusselt(
+    reynolds: NDArray[np.float64] | float,
+    prandtl: float,
+    voidage: NDArray[np.float64] | float,
+) -> NDArray[np.float64]:
+    """Gas-particle Nusselt number in fixed and fluidised beds (D.J. Gunn, Int. J. Heat Mass
+    Transfer 21 (1978) 467-476):
+
+    Nu = (7 - 10 eps + 5 eps^2)(1 + 0.7 Re^0.2 Pr^(1/3)) + (1.33 - 2.4 eps + 1.2 eps^2) Re^0.7 Pr^(1/3)
+
+    with Re = rho u d / mu on the *superficial* slip speed u = eps |U_gas - v_p| (U_gas
+    interstitial), for 0.35 <= eps <= 1 and Re <= 1e5. At eps = 1 and Re = 0 it gives Nu = 2,
+    the still-air sphere.
+
+    Raises
+    ------
+    drumflow.errors.AnalysisInputError
+        A voidage outside 0.35..1, or a negative or non-finite Reynolds number.
+    """
+    from drumflow.errors import AnalysisInputError
+
+    eps = np.asarray(voidage, float)
+    re = np.asarray(reynolds, float)
+    lo, hi = GUNN_VOIDAGE
+    if np.any(~((eps >= lo) & (eps <= hi))):
+        bad = eps[~((eps >= lo) & (eps <= hi))].ravel()[0]
+        raise AnalysisInputError("voidage", float(bad), f"Gunn's range {lo}..{hi}")
+    if np.any(~(re >= 0.0)) or np.any(~np.isfinite(re)):
+        raise AnalysisInputError("reynolds", re[~(np.isfinite(re) & (re >= 0.0))].ravel()[0],
+                                 "finite numbers >= 0")
+    pr3 = prandtl ** (1.0 / 3.0)
+    return np.asarray((7.0 - 10.0 * eps + 5.0 * eps**2) * (1.0 + 0.7 * re**0.2 * pr3)
+                      + (1.33 - 2.4 * eps + 1.2 * eps**2) * re**0.7 * pr3, dtype=float)
+
+
+def gunn_h(
+    superficial_slip: NDArray[np.float64] | float,
+    voidage: NDArray[np.float64] | float,
+    diameter: float,
+    air: AirState,
+) -> NDArray[np.float64]:
+    """Heat-transfer coefficient, W/(m2 K), of a particle of ``diameter`` (m) in a bed of
+    ``voidage`` at the superficial slip speed (m/s): Nu k_air / d, Nu by :func:`gunn_nusselt`."""
+    re = air.density * np.asarray(superficial_slip, float) * diameter / air.viscosity
+    return gunn_nusselt(re, air.prandtl, voidage) * air.conductivity / diameter
 
 
 # -- analytic references ------------------------------------------------------------------
