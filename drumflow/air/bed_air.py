@@ -152,12 +152,8 @@ def deposit_on_cells(
     module docstring). ``fluid_xy(x, y)`` tells air from metal in the cross-section (the
     section is a prism along z); ``None``: the whole box is air.
     """
-    if not spacing > 0.0 or not math.isfinite(spacing):
-        raise AnalysisInputError("spacing", spacing, "a finite length > 0 (m)")
-    lo, hi = np.asarray(lower, float), np.asarray(upper, float)
-    cells = tuple(max(1, int((hi[a] - lo[a]) // spacing)) for a in range(3))
-    grid = RectilinearGrid.uniform(lo, hi, (cells[0], cells[1], cells[2]),
-                                   periodic=(False, False, periodic_z))
+    grid = deposition_grid(lower, upper, spacing, periodic_z)
+    cells = grid.shape
     raw = deposit_solids_fraction(grid, positions, radii)
     solids = smooth_deposition(raw, passes)
     where = grid.locate(centres)
@@ -172,7 +168,7 @@ def deposit_on_cells(
     grid_fraction = np.divide(solid_flat, fluid_flat, out=np.zeros(n), where=fluid_flat > 0)
     fraction = grid_fraction[where]
     held = np.bincount(where, minlength=n) > 0
-    h = tuple(float((hi[a] - lo[a]) / cells[a]) for a in range(3))
+    h = tuple(float(grid.edges[a][-1] - grid.edges[a][0]) / cells[a] for a in range(3))
     return CellDeposit(
         fraction=fraction,
         spacing_m=(h[0], h[1], h[2]),
@@ -183,6 +179,18 @@ def deposit_on_cells(
         cells_volume_m3=float(np.sum(fraction * volumes)),
         unmapped_m3=float(solid_flat[~held].sum()),
     )
+
+
+def deposition_grid(lower: NDArray[np.float64], upper: NDArray[np.float64], spacing: float,
+                    periodic_z: bool = False) -> RectilinearGrid:
+    """The deposition grid over the box ``lower``..``upper``: cells of about ``spacing`` (m),
+    at least one per axis, periodic along z if asked (what the particles are put on)."""
+    if not spacing > 0.0 or not math.isfinite(spacing):
+        raise AnalysisInputError("spacing", spacing, "a finite length > 0 (m)")
+    lo, hi = np.asarray(lower, float), np.asarray(upper, float)
+    cells = tuple(max(1, int((hi[a] - lo[a]) // spacing)) for a in range(3))
+    return RectilinearGrid.uniform(lo, hi, (cells[0], cells[1], cells[2]),
+                                   periodic=(False, False, periodic_z))
 
 
 def _air_share(grid: RectilinearGrid, fluid_xy: Callable[..., NDArray[np.bool_]] | None,

@@ -101,12 +101,10 @@ def particle_means(centres: NDArray[np.float64], positions: NDArray[np.float64],
     (``centres``): on the grid of :func:`~drumflow.air.bed_air.deposit_on_cells` (spacing,
     box, ``passes`` 1-2-1 passes) from the particles' centres; a cell whose grid cell got no
     weight takes the mean over all particles."""
-    from drumflow.air.solids_fraction import Deposition, RectilinearGrid, smooth_deposition
+    from drumflow.air.bed_air import deposition_grid
+    from drumflow.air.solids_fraction import Deposition, smooth_deposition
 
-    lo, hi = np.asarray(lower, float), np.asarray(upper, float)
-    cells = tuple(max(1, int((hi[a] - lo[a]) // spacing)) for a in range(3))
-    grid = RectilinearGrid.uniform(lo, hi, (cells[0], cells[1], cells[2]),
-                                   periodic=(False, False, periodic_z))
+    grid = deposition_grid(lower, upper, spacing, periodic_z)
     v = np.asarray(values, float)
     flat = v.reshape(len(v), -1)
     volume = 4.0 / 3.0 * math.pi * np.asarray(radii, float) ** 3
