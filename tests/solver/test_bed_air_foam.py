@@ -8,28 +8,22 @@ minutes for the empty drum and the bed together on an idle core.
 
 from __future__ import annotations
 
-import copy
 import json
 import re
-import tomllib
-from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
 import pytest
-from support.solvers import CASES, OPENFOAM, requires_solver
+from support.porous_drum import ergun_by_hand, full_of_porosity, smoke_case
+from support.solvers import OPENFOAM, requires_solver
 
 from drumflow.air.bed_air import (
     BedAirResult,
     solve_bed_air,
     write_bed_air,
-    write_porosity_options,
 )
 from drumflow.air.foam import read_cell_fields, solve_air
-from drumflow.air.foam_case import air_properties_for, write_fv_solution
-from drumflow.air.mesh import run_foam
-from drumflow.air.solids_fraction import PorosityZones
-from drumflow.case import Case, case_from_dict
+from drumflow.air.foam_case import air_properties_for
 from drumflow.dem.state import check_state, read_state
 from drumflow.runner import Runner
 
@@ -41,17 +35,12 @@ pytestmark = [
 STATE = Path(__file__).resolve().parents[2] / "results" / "states" / "smoke_1.0s.npz"
 
 
-def _smoke() -> Case:
-    with (CASES / "smoke.toml").open("rb") as fh:
-        d = copy.deepcopy(tomllib.load(fh))
-    d["air"]["mesh_size"] = 0.03
-    return case_from_dict(d)
 
 
 @pytest.fixture(scope="module", params=["periodic", "inlet-outlet"])
 def smoke_bed_air(request: pytest.FixtureRequest, tmp_path_factory: pytest.TempPathFactory,
                   ) -> tuple[BedAirResult, list[Path]]:
-    case = _smoke()
+    case = smoke_case()
     state = read_state(STATE)
     check_state(state, case, STATE)
     work = tmp_path_factory.mktemp("bed_air")
@@ -80,9 +69,9 @@ def test_the_bed_holds_back_the_air_and_the_flow_is_conserved(
         # U_z (exact to 1e-9); the face fluxes, which are what is conserved, carry 0.56 %
         # (empty) and 0.52 % (bed) less on this 0.03 m tetrahedral mesh (the cell velocities
         # and the Rhie-Chow face fluxes differ by the discretisation, most near the walls).
-        rho, _ = air_properties_for(_smoke())
+        rho, _ = air_properties_for(smoke_case())
         for total in (empty["total"], bed["total"]):
-            assert total == pytest.approx(_smoke().air.mass_flow / rho, rel=0.01)
+            assert total == pytest.approx(smoke_case().air.mass_flow / rho, rel=0.01)
     # The smoke bed lies inside the drum: the cells get the particles' volume within 2 %.
     assert result.deposit["outside_m3"] == 0.0
     assert result.deposit["cells_over_particles"] == pytest.approx(1.0, abs=0.02)
@@ -100,23 +89,6 @@ def test_the_outputs_are_written(smoke_bed_air: tuple[BedAirResult, list[Path]])
     assert paths[2].stat().st_size > 10_000
 
 
-@pytest.mark.timeout(180)
-def _full_of_porosity(runner: Runner, d: float, f: float) -> Callable[[Path], None]:
-    """A ``prepare`` hook making every cell of the drum one Ergun zone of coefficients d, f."""
-    from foamlib import FoamFile
-
-    case = _smoke()
-
-    def prepare(work: Path) -> None:
-        n = int(np.asarray(FoamFile(work / "constant/polyMesh/owner")[None]).max()) + 1
-        zones = PorosityZones([np.arange(n)], np.array([d]), np.array([f]), np.full(n, d),
-                              np.full(n, f))
-        write_porosity_options(work, zones)
-        write_fv_solution(work, case.air.residual_target, ["p", "U", "k", "epsilon"],
-                          consistent=False)
-        run_foam(runner, "topoSet", [], work, timeout=60)
-
-    return prepare
 
 
 @pytest.mark.timeout(180)
@@ -129,12 +101,11 @@ def test_a_periodic_drum_full_of_porosity_is_pushed_by_ergun_gradient(tmp_path: 
     flow is the case's (0.1 %)."""
     from drumflow.air.periodic import read_pressure_gradient
 
-    case, runner = _smoke(), Runner()
+    case, runner = smoke_case(), Runner()
     eps, dp = 0.45, 0.008
-    d = 150.0 * (1 - eps) ** 2 / (eps**3 * dp**2)
-    f = 2.0 * 1.75 * (1 - eps) / (eps**3 * dp)
+    d, f = ergun_by_hand(eps, dp)
     solution = solve_air(case, tmp_path / "full", runner, timeout=150,
-                         prepare=_full_of_porosity(runner, d, f), periodic=True)
+                         prepare=full_of_porosity(case, runner, d, f), periodic=True)
     # The end faces were meshed alike (gmsh setPeriodic): AMI couples them face to face.
     log = (solution.case_dir / "log.simpleFoam").read_text()
     weights = re.findall(r"AMI: Patch (?:source|target) sum\(weights\) min:(\S+) max:(\S+)", log)
@@ -157,12 +128,11 @@ def test_a_drum_full_of_porosity_meets_ergun_drag(tmp_path: Path) -> None:
     1952), written and solved as the bed case is: in the slice's middle half the fitted
     pressure gradient equals the drag per volume of Ergun's law at the solved cell velocities
     within 5 % (what is left is wall shear and swirl); a law 10 % off on either side fails."""
-    case, runner = _smoke(), Runner()
+    case, runner = smoke_case(), Runner()
     eps, dp = 0.45, 0.008
-    d = 150.0 * (1 - eps) ** 2 / (eps**3 * dp**2)
-    f = 2.0 * 1.75 * (1 - eps) / (eps**3 * dp)
+    d, f = ergun_by_hand(eps, dp)
     solution = solve_air(case, tmp_path / "full", runner, timeout=150,
-                         prepare=_full_of_porosity(runner, d, f))
+                         prepare=full_of_porosity(case, runner, d, f))
     cells = read_cell_fields(solution.case_dir, solution.time_dir)
     rho, nu = air_properties_for(case)
     z, U, V = cells["C"][:, 2], cells["U"], cells["V"]

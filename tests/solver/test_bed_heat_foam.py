@@ -9,18 +9,16 @@ and with the bed, then scalarTransportFoam) about two minutes.
 
 from __future__ import annotations
 
-import copy
 import json
 import math
-import tomllib
-from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
 import pytest
-from support.solvers import CASES, OPENFOAM, requires_solver
+from support.porous_drum import ergun_by_hand, full_of_porosity, smoke_case
+from support.solvers import OPENFOAM, requires_solver
 
-from drumflow.air.bed_air import solve_bed_air, write_porosity_options
+from drumflow.air.bed_air import solve_bed_air
 from drumflow.air.bed_heat import (
     bin_heat_sources,
     measure_heat,
@@ -29,10 +27,7 @@ from drumflow.air.bed_heat import (
     turbulent_diffusivity,
 )
 from drumflow.air.foam import read_cell_fields, solve_air
-from drumflow.air.foam_case import air_properties_for, write_fv_solution
-from drumflow.air.mesh import run_foam
-from drumflow.air.solids_fraction import PorosityZones
-from drumflow.case import Case, case_from_dict
+from drumflow.air.foam_case import air_properties_for
 from drumflow.dem.state import check_state, read_state
 from drumflow.physics.air import prandtl, specific_heat
 from drumflow.runner import Runner
@@ -45,30 +40,8 @@ pytestmark = [
 STATE = Path(__file__).resolve().parents[2] / "results" / "states" / "smoke_1.0s.npz"
 
 
-def _smoke() -> Case:
-    with (CASES / "smoke.toml").open("rb") as fh:
-        d = copy.deepcopy(tomllib.load(fh))
-    d["air"]["mesh_size"] = 0.03
-    return case_from_dict(d)
 
 
-def _full_of_porosity(runner: Runner, d: float, f: float) -> Callable[[Path], None]:
-    """A ``prepare`` hook making every cell of the drum one Ergun zone of coefficients d, f
-    (as tests/solver/test_bed_air_foam.py does)."""
-    from foamlib import FoamFile
-
-    case = _smoke()
-
-    def prepare(work: Path) -> None:
-        n = int(np.asarray(FoamFile(work / "constant/polyMesh/owner")[None]).max()) + 1
-        zones = PorosityZones([np.arange(n)], np.array([d]), np.array([f]), np.full(n, d),
-                              np.full(n, f))
-        write_porosity_options(work, zones)
-        write_fv_solution(work, case.air.residual_target, ["p", "U", "k", "epsilon"],
-                          consistent=False)
-        run_foam(runner, "topoSet", [], work, timeout=60)
-
-    return prepare
 
 
 @pytest.mark.timeout(240)
@@ -85,12 +58,11 @@ def test_a_plug_flow_through_uniform_particles_warms_as_epsilon_ntu_says(tmp_pat
     on three or four tetrahedra along the 0.08 m slice, the swirl and the wall layer, the
     axial diffusion at a Peclet number near 2000). Allowed 1.5 %; a k 10 % off moves the
     closed form by 7.5 to 7.9 %, so it fails. The enthalpy balance is bookkeeping: it closes to 2e-6."""
-    case, runner = _smoke(), Runner()
+    case, runner = smoke_case(), Runner()
     eps, dp = 0.9, 0.008
-    d = 150.0 * (1 - eps) ** 2 / (eps**3 * dp**2)
-    f = 2.0 * 1.75 * (1 - eps) / (eps**3 * dp)
+    d, f = ergun_by_hand(eps, dp)
     flow = solve_air(case, tmp_path / "full", runner, timeout=150,
-                     prepare=_full_of_porosity(runner, d, f), periodic=True)
+                     prepare=full_of_porosity(case, runner, d, f), periodic=True)
     cells = read_cell_fields(flow.case_dir, flow.time_dir)
     rho, nu = air_properties_for(case)
     length = case.drum.length
@@ -128,7 +100,7 @@ def test_the_smoke_bed_gives_the_air_part_of_its_heat(tmp_path: Path) -> None:
     of 1363 W; bed cells 0.07, curtain cells 0.46), the air leaves warmer than it came (30.59
     degC from 30), and the enthalpy balance closes (bookkeeping: measured -4.8e-4 at the
     default outer residual 1e-6, -2.8e-5 at 1e-7)."""
-    case, runner = _smoke(), Runner()
+    case, runner = smoke_case(), Runner()
     state = read_state(STATE)
     check_state(state, case, STATE)
     work = tmp_path / "openfoam"
