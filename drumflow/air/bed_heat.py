@@ -41,11 +41,13 @@ the sources' range (unlimited it overshot by 13 %).
 
 Ends: a periodic flow's temperature is not periodic; the copy's cyclicAMI pair becomes plain
 patches carrying phi's cyclic values, fresh air at ``inlet`` (z = l) by a Danckwerts condition
-(``mixed``, value fraction u / (u + D / delta): T_in advected plus diffused; a fixed T_in let 9 %
-of the smoke bed's heat diffuse out upstream), ``inletOutlet`` at ``outlet``, walls adiabatic.
+(``mixed``, value fraction u / (u + D / delta); a fixed T_in let 9 % of the smoke bed's heat
+diffuse out upstream), ``inletOutlet`` at ``outlet``, walls adiabatic.
 
-The diffusivity D is one constant (:func:`turbulent_diffusivity`): the volume mean of nu_t /
-Pr_t (Pr_t = 0.85) of the solved ``nut``, plus nu / Pr (axial Peclet number in the thousands).
+D is one constant (v1912's scalarTransportFoam takes no field): by default the volume mean of
+nu_t / 0.85 of the solved ``nut`` plus nu / Pr (:func:`turbulent_diffusivity`), which lets heat
+leave the bed's cells as if they were free air (an upper bound there); ``mixing="molecular"``
+keeps nu / Pr alone (the lower bound: heat leaves the bed only with the air through it).
 """
 
 from __future__ import annotations
@@ -76,7 +78,7 @@ if TYPE_CHECKING:
     from drumflow.physics.particle_air import AirState
     from drumflow.runner import Runner
 
-__all__ = ["TURBULENT_PRANDTL", "AirTemperature", "BedHeatResult", "HeatSnapshot", "HeatZones",
+__all__ = ["MIXING", "TURBULENT_PRANDTL", "AirTemperature", "BedHeatResult", "HeatSnapshot", "HeatZones",
            "bin_heat_sources", "exchange_rate", "measure_heat", "particle_means",
            "solve_air_temperature", "solve_bed_heat", "turbulent_diffusivity"]
 
@@ -84,6 +86,8 @@ __all__ = ["TURBULENT_PRANDTL", "AirTemperature", "BedHeatResult", "HeatSnapshot
 TURBULENT_PRANDTL = 0.85
 #: Bins of log k, and of T_p inside each (:func:`bin_heat_sources`).
 K_BINS, T_BINS = 24, 6
+#: The diffusivity's choices (module notes): turbulent (default) or molecular.
+MIXING = ("turbulent", "molecular")
 
 
 def _finite(name: str, values: NDArray[np.float64], allowed: str = "finite numbers") -> None:
@@ -98,9 +102,8 @@ def particle_means(centres: NDArray[np.float64], positions: NDArray[np.float64],
                    periodic_z: bool = False, passes: int = SMOOTHING_PASSES,
                    ) -> NDArray[np.float64]:
     """Volume-weighted means of the particles' ``values`` ((n,) or (n, m)) per mesh cell
-    (``centres``): on the grid of :func:`~drumflow.air.bed_air.deposit_on_cells` (spacing,
-    box, ``passes`` 1-2-1 passes) from the particles' centres; a cell whose grid cell got no
-    weight takes the mean over all particles."""
+    (``centres``) on the grid of :func:`~drumflow.air.bed_air.deposit_on_cells` (spacing, box,
+    ``passes``); a cell whose grid cell got no weight takes the mean over all particles."""
     from drumflow.air.bed_air import deposition_grid
     from drumflow.air.solids_fraction import Deposition, smooth_deposition
 
@@ -148,14 +151,13 @@ def exchange_rate(fraction: NDArray[np.float64], air_velocity: NDArray[np.float6
         raise AnalysisInputError("fraction", float(phi[(phi < 0) | (phi >= 1)][0]),
                                  "solids fractions in 0..1 (exclusive)")
     U, vp = np.asarray(air_velocity, float), np.asarray(particle_velocity, float)
-    _finite("air_velocity", U)
-    _finite("particle_velocity", vp)
+    for name, a in (("air_velocity", U), ("particle_velocity", vp)):
+        _finite(name, a)
     eps = 1.0 - phi
     slip = np.linalg.norm(U - eps[:, None] * vp, axis=1)
     h = gunn_h(slip, np.clip(eps, *GUNN_VOIDAGE), diameter, air)
-    k = np.where(phi >= POROUS_FRACTION, h * 6.0 * phi / diameter / (air.density * heat_capacity),
-                 0.0)
-    return h, k
+    return h, np.where(phi >= POROUS_FRACTION,
+                       h * 6.0 * phi / diameter / (air.density * heat_capacity), 0.0)
 
 
 @dataclass(frozen=True)
@@ -229,8 +231,7 @@ class AirTemperature:
     outlet_theta, outflow_m3_s
         Flux-weighted theta over the outlet's outflow faces, K; their flow, m^3/s.
     other_out_m3K_s
-        What else leaves the two ends (sum of phi theta_f plus diffusion over their faces, less
-        the outlet's outflow), m^3 K/s: times rho c_p, W.
+        What else leaves the ends (phi theta_f plus diffusion, less the outlet's outflow), m^3 K/s.
     iterations, relaxation, wall_time_s
         Outer iterations, the T equation's under-relaxation, the time taken (s).
     """
@@ -460,13 +461,11 @@ class BedHeatResult:
         ends besides the outlet's air (diffusion at its backflow faces).
     by_category
         heat_W, heat_bulk_W and contact_efficiency of the bed, curtain and free-air cells.
-    diffusivity_m2_s, zones, binning_error, voidage_clipped_cells
-        D; source zones; heat with each cell's own k and T_p at the solved T over heat_W,
-        less 1; source cells whose voidage was raised to Gunn's 0.35.
-    iterations, wall_time_s
-        scalarTransportFoam's outer iterations; the time taken, s.
-    fields
-        Per cell ``T`` (degC), ``k`` (1/s) and ``T_p`` (degC).
+    mixing, diffusivity_m2_s, zones, binning_error, voidage_clipped_cells
+        One of :data:`MIXING`; D; source zones; heat with each cell's own k and T_p at the
+        solved T over heat_W, less 1; source cells whose voidage was raised to Gunn's 0.35.
+    iterations, wall_time_s, fields
+        scalarTransportFoam's outer iterations; s taken; per cell T, k (1/s) and T_p (degC).
     """
 
     case_name: str
@@ -481,6 +480,7 @@ class BedHeatResult:
     enthalpy_balance: float
     other_out_W: float
     by_category: dict[str, dict[str, float]]
+    mixing: str
     diffusivity_m2_s: float
     zones: int
     binning_error: float
@@ -490,9 +490,7 @@ class BedHeatResult:
     fields: dict[str, NDArray[np.float64]] = field(repr=False, default_factory=dict)
 
     def as_dict(self) -> dict[str, Any]:
-        out = asdict(self)
-        out.pop("fields")
-        return out
+        return {k: v for k, v in asdict(self).items() if k != "fields"}
 
 
 def measure_heat(zones: HeatZones, air: AirTemperature, volumes: NDArray[np.float64],
@@ -529,18 +527,18 @@ class HeatSnapshot(BedSnapshot, Protocol):
 def solve_bed_heat(result: BedAirResult, state: HeatSnapshot, case: Case, runner: Runner,
                    workdir: Path, *, spacing: float | None = None,
                    timeout: float | None = 600.0, k_bins: int = K_BINS, t_bins: int = T_BINS,
-                   residual: float = 1e-6) -> BedHeatResult:
+                   residual: float = 1e-6, mixing: str = "turbulent") -> BedHeatResult:
     """The heat the air takes from ``state``'s particles in the bed case that
     :func:`~drumflow.air.bed_air.solve_bed_air` solved (``result``) in ``workdir``
     (``workdir/bed``); the temperature case goes to ``workdir/heat``. ``spacing``: the
     deposition grid's, as given to :func:`~drumflow.air.bed_air.solve_bed_air` (default
     alike); ``k_bins``, ``t_bins``: :func:`bin_heat_sources`; ``residual``: the outer
-    iterations' target (:func:`solve_air_temperature`).
+    iterations' target (:func:`solve_air_temperature`); ``mixing``: one of :data:`MIXING`.
 
     Raises
     ------
     drumflow.errors.AnalysisInputError
-        A NaN particle temperature or velocity, a bad diameter or solids fraction.
+        A NaN particle temperature or velocity, a bad diameter or solids fraction, or mixing.
     drumflow.errors.SolverError
         topoSet or scalarTransportFoam failed.
     """
@@ -552,6 +550,8 @@ def solve_bed_heat(result: BedAirResult, state: HeatSnapshot, case: Case, runner
     from drumflow.physics.drum_frame import rotate_to_drum_frame
     from drumflow.physics.particle_air import GUNN_VOIDAGE, AirState
 
+    if mixing not in MIXING:
+        raise AnalysisInputError("mixing", mixing, " or ".join(MIXING))
     t0 = time.perf_counter()
     temps = np.asarray(state.temperatures_C, float)
     _finite("temperatures_C", temps)
@@ -574,7 +574,8 @@ def solve_bed_heat(result: BedAirResult, state: HeatSnapshot, case: Case, runner
     fraction = result.fields["fraction"]
     _, k = exchange_rate(fraction, cells["U"], means[:, :3], case.particles.diameter, air, cp)
     zones = bin_heat_sources(k, means[:, 3] - t_in, cells["V"], k_bins, t_bins)
-    diffusivity = turbulent_diffusivity(bed_dir, time_dir, cells["V"], nu, air.prandtl)
+    diffusivity = (turbulent_diffusivity(bed_dir, time_dir, cells["V"], nu, air.prandtl)
+                   if mixing == "turbulent" else nu / air.prandtl)
     solved = solve_air_temperature(bed_dir, time_dir, Path(workdir) / "heat", zones,
                                    diffusivity, runner, timeout, residual)
     heat, bulk, split, binning = measure_heat(zones, solved, cells["V"], fraction, rho * cp)
@@ -591,7 +592,7 @@ def solve_bed_heat(result: BedAirResult, state: HeatSnapshot, case: Case, runner
         particle_mean_temperature_C=tp_mean,
         enthalpy_balance=advected / heat - 1.0 if heat else math.nan,
         other_out_W=rho * cp * solved.other_out_m3K_s,
-        by_category=split, diffusivity_m2_s=diffusivity, zones=len(zones.cells),
+        by_category=split, mixing=mixing, diffusivity_m2_s=diffusivity, zones=len(zones.cells),
         binning_error=binning,
         voidage_clipped_cells=int(np.sum((k > 0) & (eps < GUNN_VOIDAGE[0]))),
         iterations=solved.iterations, wall_time_s=time.perf_counter() - t0,

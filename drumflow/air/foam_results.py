@@ -48,6 +48,8 @@ class ResidualParser:
         self.rows: list[dict[str, float]] = []
         self.converged = False
         self.converged_at: int | None = None
+        #: Per field, the iterations whose first solve did no sweep (a field left as it was).
+        self.unsolved: dict[str, int] = {}
         self._current: dict[str, float] | None = None
         self._on_iteration = on_iteration
 
@@ -77,6 +79,8 @@ class ResidualParser:
             name = m.group(1)
             if name not in self._current:
                 self._current[name] = float(m.group(2))
+                if int(m.group(4)) == 0:
+                    self.unsolved[name] = self.unsolved.get(name, 0) + 1
             return
         m = _CONVERGED_RE.search(line)
         if m:

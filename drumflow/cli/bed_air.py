@@ -48,6 +48,9 @@ def bed_air(
     heat: Annotated[bool, typer.Option("--heat", help="also solve the air's temperature with "
                                        "the particles' heat (Gunn) and write heat.json: the "
                                        "contact efficiency")] = False,
+    mixing: Annotated[str, typer.Option("--mixing", help="the heat's diffusivity: turbulent (the "
+                                        "mean nu_t, an upper bound for the bed's heat) or "
+                                        "molecular (the lower bound)")] = "turbulent",
     work: Annotated[Optional[Path], typer.Option(
         "--work", help="where the OpenFOAM cases go (default /var/tmp/drumflow-runs/bed_air/"
         "<out folder name>)")] = None,
@@ -55,6 +58,7 @@ def bed_air(
     """Solve the drum's air with a bed state's particles as porosity (Ergun), once, and
     measure the through-flow of bed, curtains and free air against the empty drum."""
     from drumflow.air.bed_air import AXIAL_MODES, solve_bed_air, write_bed_air
+    from drumflow.air.bed_heat import MIXING
     from drumflow.dem.state import check_state, read_state
     from drumflow.errors import AnalysisInputError
     from drumflow.geometry.fluid import fluid_mesh_size
@@ -76,6 +80,8 @@ def bed_air(
         raise AnalysisInputError("--processes", processes, "an integer from 1 to 256")
     if axial not in AXIAL_MODES:
         raise AnalysisInputError("--axial", axial, " or ".join(AXIAL_MODES))
+    if mixing not in MIXING:
+        raise AnalysisInputError("--mixing", mixing, " or ".join(MIXING))
     workdir = work or DEFAULT_WORK / out.resolve().name
     err_console.print(f"solving the empty drum and the bed in {workdir} ...", highlight=False)
     result = solve_bed_air(case, state, workdir, Runner(), spacing=grid_spacing,
@@ -87,7 +93,8 @@ def bed_air(
 
         err_console.print("solving the air's temperature with the particles' heat ...",
                           highlight=False)
-        warm = solve_bed_heat(result, state, case, Runner(), workdir, spacing=grid_spacing)
+        warm = solve_bed_heat(result, state, case, Runner(), workdir, spacing=grid_spacing,
+                              mixing=mixing)
         paths.append(out / "heat.json")
         paths[-1].write_text(json.dumps(warm.as_dict(), indent=2, default=float) + "\n")
         console.print(

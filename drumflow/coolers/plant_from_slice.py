@@ -30,8 +30,8 @@ if TYPE_CHECKING:
     from drumflow.physics.exchanger import ExchangerResult
 
 __all__ = ["PAPER_TABLE7", "DrumInputs", "PlantFromSlice", "PlantFromSliceFiles",
-           "curtain_air_setting", "plant_from_slice", "plot_curtain_air", "plot_drum",
-           "slice_closures", "write_plant_from_slice"]
+           "curtain_air_from_slice", "curtain_air_setting", "plant_from_slice", "plot_curtain_air",
+           "plot_drum", "slice_closures", "write_plant_from_slice"]
 
 #: Table 7 of the paper, model one: its exchanger prediction of the plant.
 PAPER_TABLE7 = {"material_outlet_C": 40.90, "air_outlet_C": 69.73}
@@ -83,17 +83,53 @@ def slice_closures(source: Path, start: float | None) -> SliceClosures:
     return load_closures(source)
 
 
-def curtain_air_setting(value: str) -> float | None:
-    """``--curtain-air``: 'all' (None) or a flow in m3/s per metre of drum.
+def curtain_air_from_slice(path: Path) -> float:
+    """The through-curtain air a periodic slice measured: ``saturated_flow_m3_s_m`` of the
+    ``heat.json`` of ``drumflow bed-air --axial periodic --heat`` (its ``split.json`` beside it
+    says the set-up). The saturated flow is the air per metre that would leave at the particles'
+    mean temperature with the heat the slice's air took: what the plant model's through-curtain
+    stream stands for (chosen so when the bed-air heat was built, before any comparison).
 
     Raises
     ------
     DrumModelError
-        Neither 'all' nor a flow from 0 to :data:`MAX_CURTAIN_AIR_M3_S_M`.
+        The file missing or unreadable, no saturated flow in it, an inlet-outlet slice (a 0.1 m
+        slice's inlet forces fresh air through the bed: not a piece of a long drum), or a flow
+        outside 0 to :data:`MAX_CURTAIN_AIR_M3_S_M`.
     """
-    allowed = (f"allowed 'all' or 0 to {MAX_CURTAIN_AIR_M3_S_M:g} m3/s per metre of drum")
+    import json
+
+    try:
+        heat = json.loads(path.read_text())
+        axial = json.loads((path.parent / "split.json").read_text()).get("axial")
+        flow = float(heat["saturated_flow_m3_s_m"])
+    except (OSError, ValueError, KeyError, TypeError, AttributeError) as err:
+        raise DrumModelError(f"--curtain-air {path}: not a bed-air heat.json with its split.json "
+                             f"beside it ({type(err).__name__}: {err})") from None
+    if axial != "periodic":
+        raise DrumModelError(f"--curtain-air {path}: a slice solved with axial = {axial}; "
+                             "allowed: periodic (drumflow bed-air --axial periodic --heat)")
+    if not (math.isfinite(flow) and 0.0 <= flow <= MAX_CURTAIN_AIR_M3_S_M):
+        raise DrumModelError(f"--curtain-air {path}: saturated_flow_m3_s_m = {flow}: allowed 0 "
+                             f"to {MAX_CURTAIN_AIR_M3_S_M:g} m3/s per metre of drum")
+    return flow
+
+
+def curtain_air_setting(value: str) -> float | None:
+    """``--curtain-air``: 'all' (None), a flow in m3/s per metre of drum, or a periodic slice's
+    ``heat.json`` (:func:`curtain_air_from_slice`).
+
+    Raises
+    ------
+    DrumModelError
+        Neither 'all', nor a flow from 0 to :data:`MAX_CURTAIN_AIR_M3_S_M`, nor such a file.
+    """
+    allowed = (f"allowed 'all', 0 to {MAX_CURTAIN_AIR_M3_S_M:g} m3/s per metre of drum, or a "
+               "periodic slice's heat.json")
     if value.strip().lower() == "all":
         return None
+    if value.strip().endswith(".json"):
+        return curtain_air_from_slice(Path(value.strip()))
     try:
         flow = float(value)
     except ValueError:
@@ -161,8 +197,8 @@ class PlantFromSlice:
     points, needed
         The outlets over the through-curtain air (empty without the sweep), and the flow the
         plant's measured NPK outlet would need (the paper's plant only).
-    curtain_air
-        The through-curtain flow asked for (None: 'all').
+    curtain_air, curtain_air_from
+        The through-curtain flow asked for (None: 'all'); the slice file it came from, if any.
     """
 
     source: Path
@@ -178,6 +214,7 @@ class PlantFromSlice:
     textbook: ExchangerResult
     exchanger: ExchangerResult
     curtain_air: float | None
+    curtain_air_from: str | None = None
     points: list[CurtainAirPoint] = field(default_factory=list)
     needed: NeededCurtainAir | None = None
 
@@ -212,6 +249,7 @@ class PlantFromSlice:
             },
             "curtain_air": {
                 "setting_m3_s_per_m": self.curtain_air,
+                "from_slice": self.curtain_air_from,
                 "default_note": CURTAIN_AIR_DEFAULT_NOTE,
                 "sweep": [p.to_dict() for p in self.points],
                 "needed_for_measured_material_outlet": self.needed.to_dict() if self.needed else None,
@@ -301,7 +339,8 @@ def plant_from_slice(source: Path, *, cells: int = 40, rpm: float | None = None,
         source=source, closures=closures, base=base, plant=plant, law=law, options=options,
         result=result, wall_s=wall,
         warnings=extrapolation_warnings(plant, base, closures, result.scaled) + result.warnings,
-        textbook_ua=ua, textbook=textbook, exchanger=paper_exchanger(plant), curtain_air=curtain_flow)
+        textbook_ua=ua, textbook=textbook, exchanger=paper_exchanger(plant), curtain_air=curtain_flow,
+        curtain_air_from=curtain_air.strip() if curtain_air.strip().endswith(".json") else None)
     # The through-curtain flow is the closure no slice measures yet: show what it changes.
     if sweep:
         evaluation.points = sweep_curtain_air(plant, closures, law, options)

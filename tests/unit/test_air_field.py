@@ -243,6 +243,30 @@ def test_residual_log_parser_keeps_the_first_solve_of_each_field() -> None:
     assert df.loc[1, "Ux"] == pytest.approx(5e-5)
 
 
+def test_residual_log_parser_counts_the_iterations_a_field_was_left_unsolved() -> None:
+    from drumflow.air.foam_results import ResidualParser
+
+    parser = ResidualParser()
+    for line in _LOG.replace("Initial residual = 4e-05, Final residual = 1e-6, No Iterations 2",
+                             "Initial residual = 4e-09, Final residual = 4e-09, No Iterations 0"
+                             ).splitlines():
+        parser(line)
+    assert parser.unsolved == {"Uy": 1}
+
+
+def test_turbulence_fields_get_a_sweep_every_iteration(tmp_path: Path) -> None:
+    """Regression: k's normalised residual fell below the absolute tolerance in periodic drums
+    and k was never solved again (model two's periodic bed never converged)."""
+    from foamlib import FoamFile
+
+    from drumflow.air.foam_case import write_fv_solution
+
+    (tmp_path / "system").mkdir()
+    write_fv_solution(tmp_path, 1e-4, ["p", "U", "k", "epsilon"])
+    solvers = FoamFile(tmp_path / "system" / "fvSolution")["solvers"]
+    assert solvers['"(U|k|epsilon)"']["minIter"] == 1  # type: ignore[index]
+
+
 def test_not_converged_error_names_the_worst_residual() -> None:
     err = AirNotConvergedError(10, {"Ux": 1e-3, "epsilon": 2e-2}, 1e-4, Path("log.simpleFoam"))
     assert "epsilon" in str(err) and "10 SIMPLE iterations" in str(err)

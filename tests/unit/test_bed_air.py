@@ -142,6 +142,8 @@ ROOT = Path(__file__).resolve().parents[2]
     (["cases/smoke.toml", "--state", "results/states/no_such_state.npz"], "no_such_state.npz"),
     (["cases/smoke.toml", "--state", "results/states/smoke_1.0s.npz", "--axial", "cyclic"],
      "--axial = cyclic"),
+    (["cases/smoke.toml", "--state", "results/states/smoke_1.0s.npz", "--heat", "--mixing",
+      "laminar"], "--mixing = laminar"),
 ])
 def test_bad_input_is_refused_before_any_solver(tmp_path: Path, args: list[str],
                                                 named: str) -> None:

@@ -4,6 +4,7 @@ the prediction over it, and the plant's measured balance. Hand-written closures,
 from __future__ import annotations
 
 import dataclasses
+import json
 import math
 from pathlib import Path
 
@@ -224,5 +225,42 @@ def test_cli_refuses_a_bad_curtain_air(value: str, tmp_path: Path) -> None:
                           f"--curtain-air={value}", "--out", str(tmp_path / "plant")],
                          capture_output=True, text=True, timeout=120, check=False)
     assert out.returncode == 2, out.stdout + out.stderr
-    assert f"--curtain-air = {value}" in out.stderr and "allowed 'all' or 0 to" in out.stderr
+    assert f"--curtain-air = {value}" in out.stderr and "allowed 'all', 0 to" in out.stderr
     assert "Traceback" not in out.stderr
+
+
+def test_the_curtain_air_comes_from_a_periodic_slice_file(tmp_path: Path) -> None:
+    """A periodic bed-air heat.json gives its saturated flow; an inlet-outlet one, a missing
+    or a broken file are refused by name."""
+    from drumflow.coolers.drum import DrumModelError
+    from drumflow.coolers.plant_from_slice import curtain_air_setting
+
+    heat, split = tmp_path / "heat.json", tmp_path / "split.json"
+    heat.write_text(json.dumps({"saturated_flow_m3_s_m": 1.25}))
+    split.write_text(json.dumps({"axial": "periodic"}))
+    assert curtain_air_setting(str(heat)) == pytest.approx(1.25)
+    split.write_text(json.dumps({"axial": "inlet-outlet"}))
+    with pytest.raises(DrumModelError, match="axial = inlet-outlet; allowed: periodic"):
+        curtain_air_setting(str(heat))
+    split.write_text(json.dumps({"axial": "periodic"}))
+    heat.write_text(json.dumps({"saturated_flow_m3_s_m": -3.0}))
+    with pytest.raises(DrumModelError, match="saturated_flow_m3_s_m = -3.0"):
+        curtain_air_setting(str(heat))
+    heat.write_text("{ truncated")
+    with pytest.raises(DrumModelError, match="heat.json: not a bed-air heat.json"):
+        curtain_air_setting(str(heat))
+    with pytest.raises(DrumModelError, match="nothing.json"):
+        curtain_air_setting(str(tmp_path / "nothing.json"))
+
+
+def test_the_plant_from_the_shipped_periodic_slice_records_its_source() -> None:
+    from drumflow.coolers.plant_from_slice import plant_from_slice
+
+    root = Path(__file__).resolve().parents[2]
+    heat = root / "results" / "air" / "bed_air_model_two_5.0s_mesh0.1_periodic" / "heat.json"
+    evaluation = plant_from_slice(root / "docs" / "plant" / "smoke_closures.json",
+                                  curtain_air=str(heat), sweep=False)
+    flow = json.loads(heat.read_text())["saturated_flow_m3_s_m"]
+    answer = evaluation.to_dict()
+    assert answer["curtain_air"]["setting_m3_s_per_m"] == pytest.approx(flow)
+    assert answer["curtain_air"]["from_slice"] == str(heat)

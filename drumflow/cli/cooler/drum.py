@@ -36,8 +36,10 @@ def drum(
         "--lumped", help="lumped particles (Bi -> 0) instead of interior conduction")] = False,
     curtain_air: Annotated[str, typer.Option(
         "--curtain-air", help="air through the curtains, m3/s per metre of drum (at the air "
-                              "inlet temperature), or 'all': all the air meets every falling "
-                              "granule (the default: the one setting not chosen from the "
+                              "inlet temperature), a periodic slice's heat.json (drumflow "
+                              "bed-air --heat: its saturated flow), or 'all': all the air "
+                              "meets every falling granule (the default: the one setting not "
+                              "chosen from the "
                               "plant; the bound of most contact). Every run also reports the "
                               "outlets over a range of it")] = "all",
     sweep: Annotated[bool, typer.Option(
