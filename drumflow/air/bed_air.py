@@ -62,8 +62,8 @@ if TYPE_CHECKING:
     from drumflow.runner import Runner
 
 __all__ = ["BED_FRACTION", "CURTAIN_FRACTION", "POROUS_FRACTION", "AirMeasure", "BedAirResult",
-           "BedSnapshot", "CellDeposit", "PolyMesh", "categorize", "deposit_on_cells", "inflow_into",
-           "measure_air", "porosity_zones", "read_poly_mesh", "section_flow", "solve_bed_air",
+           "BedSnapshot", "CellDeposit", "PolyMesh", "categorize", "deposit_on_cells", "deposit_state",
+           "inflow_into", "measure_air", "porosity_zones", "read_poly_mesh", "section_flow", "solve_bed_air",
            "write_bed_air", "write_porosity_options"]
 
 #: Cells with at least this solids fraction are bed cells.
@@ -424,6 +424,24 @@ def write_porosity_options(case_dir: Path, zones: PorosityZones) -> None:
             }
 
 
+def deposit_state(case: Case, state: BedSnapshot, mesh: PolyMesh,
+                  cells: dict[str, NDArray[np.float64]], spacing: float | None = None,
+                  ) -> CellDeposit:
+    """``state``'s solids on the air mesh's cells (``cells``: centres ``C``, volumes ``V``),
+    in the drum's frame, at ``spacing`` (default: the larger of two parcel diameters and the
+    air mesh size), periodic along the axis when the drum's ends are."""
+    from drumflow.air.field_grid import fluid_mask_xy
+    from drumflow.geometry.fluid import fluid_mesh_size
+    from drumflow.physics.drum_frame import rotate_to_drum_frame
+
+    h = spacing if spacing is not None else max(4.0 * float(state.radii.max()),
+                                                fluid_mesh_size(case))
+    positions = rotate_to_drum_frame(state.positions, state.drum_angle_rad)
+    return deposit_on_cells(cells["C"], cells["V"], positions, state.radii, mesh.bounds[0],
+                            mesh.bounds[1], h, lambda x, y: fluid_mask_xy(case, x, y),
+                            periodic_z=case.drum.ends == "periodic")
+
+
 def solve_bed_air(
     case: Case,
     state: BedSnapshot,
@@ -462,13 +480,10 @@ def solve_bed_air(
     drumflow.errors.AnalysisInputError
         A grid spacing that fills a cell with solids.
     """
-    from drumflow.air.field_grid import fluid_mask_xy
     from drumflow.air.foam import solve_air
     from drumflow.air.foam_case import air_properties_for, write_fv_solution
     from drumflow.air.foam_results import read_cell_fields
     from drumflow.air.mesh import run_foam
-    from drumflow.geometry.fluid import fluid_mesh_size
-    from drumflow.physics.drum_frame import rotate_to_drum_frame
 
     if axial not in AXIAL_MODES:
         raise AnalysisInputError("axial", axial, f"one of {', '.join(AXIAL_MODES)}")
@@ -482,12 +497,7 @@ def solve_bed_air(
                       periodic=periodic)
     mesh = read_poly_mesh(empty.case_dir)
     cells = read_cell_fields(empty.case_dir, empty.time_dir)
-    h = spacing if spacing is not None else max(4.0 * float(state.radii.max()),
-                                                fluid_mesh_size(case))
-    positions = rotate_to_drum_frame(state.positions, state.drum_angle_rad)
-    deposit = deposit_on_cells(cells["C"], cells["V"], positions, state.radii, mesh.bounds[0],
-                               mesh.bounds[1], h, lambda x, y: fluid_mask_xy(case, x, y),
-                               periodic_z=case.drum.ends == "periodic")
+    deposit = deposit_state(case, state, mesh, cells, spacing)
     rho, nu = air_properties_for(case)
     diameter = case.particles.diameter
     zones = porosity_zones(deposit.fraction, cells["V"], diameter, law)

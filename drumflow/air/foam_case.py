@@ -361,8 +361,10 @@ def write_decompose_dict(case_dir: Path, processes: int, axis: int = 0) -> None:
 
 # -- porosity zones (drumflow.air.bed_air, drumflow.verify.porous_foam) ----------------
 
-def write_zone_sets(case_dir: Path, zones: PorosityZones) -> None:
-    """``system/topoSetDict``: one cellZoneSet per zone, from its cell list."""
+def write_zone_sets(case_dir: Path, zones: PorosityZones, names: list[str] | None = None,
+                    ) -> None:
+    """``system/topoSetDict``: one cellZoneSet per zone, from its cell list, named ``names``
+    (default the zones' own)."""
     from foamlib import FoamFile
 
     topo = case_dir / "system" / "topoSetDict"
@@ -371,7 +373,7 @@ def write_zone_sets(case_dir: Path, zones: PorosityZones) -> None:
         f["actions"] = [
             {"name": name, "type": "cellZoneSet", "action": "new", "source": "labelToCell",
              "value": [int(c) for c in cells]}
-            for name, cells in zip(zones.names, zones.cells, strict=True)
+            for name, cells in zip(names or zones.names, zones.cells, strict=True)
         ]
 
 

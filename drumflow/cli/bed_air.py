@@ -1,11 +1,11 @@
-"""`drumflow bed-air CASE --state STATE.npz --out DIR [--heat]`: the drum's air solved once with
+"""`drumflow bed-air CASE --state STATE.npz --out DIR [--heat | --heat-only]`: the drum's air solved once with
 a bed state's particles as Ergun porosity, beside the empty drum's, and what the bed and the
 curtains do to it (:mod:`drumflow.air.bed_air`); with ``--heat`` also the air's temperature
 with the particles' heat, and the contact efficiency (:mod:`drumflow.air.bed_heat`).
 
 Exit codes (:func:`drumflow.errors.exit_code`): 0 written, 1 OpenFOAM failed or did not
 converge, 2 bad input (case file, a state of another scene, a grid spacing out of range, an
-unknown ``--axial``), 130
+unknown ``--axial`` or ``--mixing``, ``--heat-only`` without a matching earlier run), 130
 interrupted. Bad input is refused before any solver starts.
 """
 
@@ -23,7 +23,8 @@ from drumflow.cli._common import load_case_file
 from drumflow.cli._guard import console, err_console
 
 if TYPE_CHECKING:
-    from drumflow.air.bed_air import BedAirResult
+    from drumflow.air.bed_air import BedAirResult, BedSnapshot
+    from drumflow.case import Case
 
 __all__ = ["bed_air"]
 
@@ -48,25 +49,67 @@ def bed_air(
     heat: Annotated[bool, typer.Option("--heat", help="also solve the air's temperature with "
                                        "the particles' heat (Gunn) and write heat.json: the "
                                        "contact efficiency")] = False,
-    mixing: Annotated[str, typer.Option("--mixing", help="the heat's diffusivity: turbulent (the "
-                                        "mean nu_t, an upper bound for the bed's heat) or "
-                                        "molecular (the lower bound)")] = "turbulent",
+    mixing: Annotated[str, typer.Option("--mixing", help="the heat's diffusivity: local (each "
+                                        "cell's own: the solved turbulence in free air and "
+                                        "curtains, a packed bed's dispersion in the bed), "
+                                        "turbulent (the mean nu_t everywhere, an upper bound for "
+                                        "the bed's heat) or molecular (the lower bound)")
+                      ] = "local",
+    heat_only: Annotated[bool, typer.Option("--heat-only", help="only the air's temperature "
+                                            "(implies --heat), on the flow an earlier run solved "
+                                            "in the work folder for this state; its split.json in "
+                                            "--out must match")] = False,
     work: Annotated[Optional[Path], typer.Option(
         "--work", help="where the OpenFOAM cases go (default /var/tmp/drumflow-runs/bed_air/"
         "<out folder name>)")] = None,
 ) -> None:
     """Solve the drum's air with a bed state's particles as porosity (Ergun), once, and
     measure the through-flow of bed, curtains and free air against the empty drum."""
-    from drumflow.air.bed_air import AXIAL_MODES, solve_bed_air, write_bed_air
-    from drumflow.air.bed_heat import MIXING
+    from drumflow.air.bed_air import solve_bed_air, write_bed_air
     from drumflow.dem.state import check_state, read_state
-    from drumflow.errors import AnalysisInputError
-    from drumflow.geometry.fluid import fluid_mesh_size
     from drumflow.runner import Runner
 
     case = load_case_file(case_file)
     state = read_state(state_file)
     check_state(state, case, state_file)
+    _check_options(case, case_file, grid_spacing, processes, axial, mixing)
+    workdir = work or DEFAULT_WORK / out.resolve().name
+    result: BedAirResult | None = None
+    paths: list[Path] = []
+    if heat_only:
+        _check_reuse(out / "split.json", case.name, state, axial)
+    else:
+        err_console.print(f"solving the empty drum and the bed in {workdir} ...", highlight=False)
+        result = solve_bed_air(case, state, workdir, Runner(), spacing=grid_spacing,
+                               processes=processes, axial=axial)  # type: ignore[arg-type]
+        paths = list(write_bed_air(result, out))
+        _print_split(result, case.name, axial)
+    if heat or heat_only:
+        from drumflow.air.bed_heat import solve_bed_heat
+
+        err_console.print("solving the air's temperature with the particles' heat ...",
+                          highlight=False)
+        warm = solve_bed_heat(result, state, case, Runner(), workdir, spacing=grid_spacing,
+                              mixing=mixing)
+        # One file per mixing, so the bounds sit beside the default.
+        paths.append(out / ("heat.json" if mixing == "local" else f"heat_{mixing}.json"))
+        paths[-1].write_text(json.dumps(warm.as_dict(), indent=2, default=float) + "\n")
+        console.print(
+            f"heat taken by the air {warm.heat_W / 1e3:.4g} kW of {warm.heat_bulk_W / 1e3:.4g} kW "
+            f"with fresh air everywhere: contact efficiency {warm.contact_efficiency:.3f}; air "
+            f"{warm.air_inlet_temperature_C:.1f} -> {warm.air_outlet_temperature_C:.2f} C; as "
+            f"saturated air {warm.saturated_flow_m3_s_m:.3g} m3/s per metre", highlight=False)
+    console.print("written: " + ", ".join(str(p) for p in paths), highlight=False)
+
+
+def _check_options(case: Case, case_file: Path, grid_spacing: float | None, processes: int,
+                   axial: str, mixing: str) -> None:
+    """Refuse, by name, what no solver should start with."""
+    from drumflow.air.bed_air import AXIAL_MODES
+    from drumflow.air.bed_heat import MIXING
+    from drumflow.errors import AnalysisInputError
+    from drumflow.geometry.fluid import fluid_mesh_size
+
     if case.air.model != "cfd":
         raise AnalysisInputError(f"{case_file}: air.model", case.air.model, "'cfd'")
     if grid_spacing is not None:
@@ -82,27 +125,26 @@ def bed_air(
         raise AnalysisInputError("--axial", axial, " or ".join(AXIAL_MODES))
     if mixing not in MIXING:
         raise AnalysisInputError("--mixing", mixing, " or ".join(MIXING))
-    workdir = work or DEFAULT_WORK / out.resolve().name
-    err_console.print(f"solving the empty drum and the bed in {workdir} ...", highlight=False)
-    result = solve_bed_air(case, state, workdir, Runner(), spacing=grid_spacing,
-                           processes=processes, axial=axial)  # type: ignore[arg-type]
-    paths = list(write_bed_air(result, out))
-    _print_split(result, case.name, axial)
-    if heat:
-        from drumflow.air.bed_heat import solve_bed_heat
 
-        err_console.print("solving the air's temperature with the particles' heat ...",
-                          highlight=False)
-        warm = solve_bed_heat(result, state, case, Runner(), workdir, spacing=grid_spacing,
-                              mixing=mixing)
-        paths.append(out / "heat.json")
-        paths[-1].write_text(json.dumps(warm.as_dict(), indent=2, default=float) + "\n")
-        console.print(
-            f"heat taken by the air {warm.heat_W / 1e3:.4g} kW of {warm.heat_bulk_W / 1e3:.4g} kW "
-            f"with fresh air everywhere: contact efficiency {warm.contact_efficiency:.3f}; air "
-            f"{warm.air_inlet_temperature_C:.1f} -> {warm.air_outlet_temperature_C:.2f} C; as "
-            f"saturated air {warm.saturated_flow_m3_s_m:.3g} m3/s per metre", highlight=False)
-    console.print("written: " + ", ".join(str(p) for p in paths), highlight=False)
+
+def _check_reuse(split_file: Path, case_name: str, state: BedSnapshot, axial: str) -> None:
+    """Refuse --heat-only unless ``split_file`` records this case, state and --axial."""
+    from drumflow.errors import AnalysisInputError
+
+    if not split_file.is_file():
+        raise AnalysisInputError(f"{split_file}", "missing", "the split.json of an earlier "
+                                 "drumflow bed-air run with the same --out")
+    try:
+        split = json.loads(split_file.read_text())
+        was = (split["case_name"], split["axial"], float(split["state"]["time_s"]),
+               int(split["state"]["particles"]))
+    except (ValueError, KeyError, TypeError) as exc:
+        raise AnalysisInputError(f"{split_file}", f"unreadable ({exc})",
+                                 "a split.json written by drumflow bed-air") from exc
+    now = (case_name, axial, float(state.time_s), len(state))
+    if was[:2] != now[:2] or not math.isclose(was[2], now[2], abs_tol=1e-9) or was[3] != now[3]:
+        raise AnalysisInputError(f"{split_file}", f"case, --axial, state time, particles {was}",
+                                 f"those of this run {now}")
 
 
 def _print_split(result: BedAirResult, case_name: str, axial: str) -> None:

@@ -4,6 +4,7 @@ face-flux counting of the through-flow, and the Ergun coefficients of a zone."""
 from __future__ import annotations
 
 import math
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -144,6 +145,8 @@ ROOT = Path(__file__).resolve().parents[2]
      "--axial = cyclic"),
     (["cases/smoke.toml", "--state", "results/states/smoke_1.0s.npz", "--heat", "--mixing",
       "laminar"], "--mixing = laminar"),
+    (["cases/smoke.toml", "--state", "results/states/smoke_1.0s.npz", "--heat-only"],
+     "split.json = missing"),
 ])
 def test_bad_input_is_refused_before_any_solver(tmp_path: Path, args: list[str],
                                                 named: str) -> None:
@@ -172,3 +175,26 @@ def test_a_case_without_a_periodic_gradient_is_refused_by_name(tmp_path: Path) -
         "Pressure gradient source: uncorrected Ubar = 3.05, pressure gradient = 0.25\n"
         "Pressure gradient source: uncorrected Ubar = 3.054, pressure gradient = 0.2007\n")
     assert read_pressure_gradient(tmp_path, "5") == pytest.approx(0.2007)
+
+
+@pytest.mark.parametrize(("args", "named"), [
+    (["--axial", "inlet-outlet"], "split.json = case, --axial, state time, particles"),
+    ([], "/bed = no converged bed-air solution"),
+])
+def test_a_heat_only_rerun_must_match_an_earlier_run(tmp_path: Path, args: list[str],
+                                                    named: str) -> None:
+    """--heat-only reuses the flow an earlier run left: refused (exit 2, by name, before any
+    solver) when the out folder's split.json is of another set-up, or the work folder holds
+    no converged bed case."""
+    out = tmp_path / "out"
+    out.mkdir()
+    shutil.copyfile(ROOT / "results/air/bed_air_smoke_1.0s_periodic/split.json",
+                    out / "split.json")
+    done = subprocess.run([sys.executable, "-m", "drumflow.cli", "bed-air", "cases/smoke.toml",
+                           "--state", "results/states/smoke_1.0s.npz", "--heat-only", *args,
+                           "--out", str(out), "--work", str(tmp_path / "work")],
+                          cwd=ROOT, capture_output=True, text=True, timeout=120)
+    assert done.returncode == 2, done.stderr
+    assert named in " ".join(done.stderr.split())
+    assert "Traceback" not in done.stderr
+    assert sorted(p.name for p in out.iterdir()) == ["split.json"]

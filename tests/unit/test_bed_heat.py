@@ -11,12 +11,16 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from drumflow.air.bed_air import POROUS_FRACTION
+from drumflow.air.bed_air import BED_FRACTION, POROUS_FRACTION
 from drumflow.air.bed_heat import (
+    TURBULENT_PRANDTL,
     bin_heat_sources,
+    cell_diffusivity,
     exchange_rate,
     particle_means,
+    solve_air_temperature,
     solve_bed_heat,
+    superficial_slip,
 )
 from drumflow.errors import AnalysisInputError
 from drumflow.physics.particle_air import AirState, gunn_h, gunn_nusselt
@@ -147,3 +151,56 @@ def test_bad_sources_and_temperatures_are_refused_by_name(tmp_path: Path) -> Non
         solve_bed_heat(SimpleNamespace(), state, SimpleNamespace(), SimpleNamespace(),  # type: ignore[arg-type]
                        tmp_path)
     assert err.value.name == "temperatures_C"
+
+
+def test_local_diffusivity_by_hand() -> None:
+    """Three cells: free air (phi 0), a curtain (0.05) and the bed (0.55), nu_t 1e-3 m^2/s
+    in each, nu = 1.6e-5, Pr = 0.71, d = 8 mm, superficial slip 0.2 m/s. Outside the bed
+    D = 2.253521e-5 + 1.176471e-3 = 1.199006e-3; in the bed the k-epsilon nu_t is not used:
+    D = 0.45 x 1.6e-5 / 0.71 + 0.1 x 0.2 x 0.008 = 1.014085e-5 + 1.6e-4 = 1.701408e-4
+    (Yagi & Kunii's 0.1: a coefficient 10 % off moves it by 9.4 %, far past 1e-6)."""
+    assert BED_FRACTION < 0.55 and TURBULENT_PRANDTL == 0.85
+    d = cell_diffusivity(np.full(3, 1e-3), np.array([0.0, 0.05, 0.55]), np.full(3, 0.2),
+                         0.008, 1.6e-5, 0.71)
+    assert d == pytest.approx([1.199006e-3, 1.199006e-3, 1.701408e-4], rel=1e-6)
+    with pytest.raises(AnalysisInputError) as err:
+        cell_diffusivity(np.array([1e-3, -1e-3]), np.zeros(2), np.zeros(2), 0.008, 1.6e-5, 0.71)
+    assert err.value.name == "nut"
+
+
+def test_superficial_slip_by_hand() -> None:
+    """U = (0, 0, 1) superficial, v_p = (0, 0, 2) at phi = 0.4: U - 0.6 v_p = (0, 0, -0.2)."""
+    slip = superficial_slip(np.array([0.4]), np.array([[0.0, 0.0, 1.0]]),
+                            np.array([[0.0, 0.0, 2.0]]))
+    assert slip == pytest.approx([0.2], rel=1e-12)
+
+
+@pytest.mark.parametrize(("diffusivity", "value"), [
+    (-1e-3, -1e-3), (math.nan, None), (np.array([1e-3, math.inf, 1e-3]), math.inf),
+    (np.full(2, 1e-3), "(2,) values"),
+])
+def test_bad_diffusivity_is_refused_before_any_solver(tmp_path: Path, diffusivity: object,
+                                                      value: object) -> None:
+    """One value or one per cell, finite and >= 0; refused by name before the case is
+    copied (the bed case here does not even exist)."""
+    zones = bin_heat_sources(np.ones(3), np.ones(3), np.ones(3))
+    with pytest.raises(AnalysisInputError) as err:
+        solve_air_temperature(tmp_path / "bed", "5", tmp_path / "heat", zones,
+                              diffusivity, SimpleNamespace())  # type: ignore[arg-type]
+    assert err.value.name == "diffusivity"
+    if value is not None:
+        assert err.value.value == value
+    assert not (tmp_path / "heat").exists()
+
+
+def test_a_heat_only_rerun_without_a_converged_bed_is_refused(tmp_path: Path) -> None:
+    """``result=None`` reuses the work folder's bed case; without a converged simpleFoam log
+    there the error names the folder."""
+    state = SimpleNamespace(temperatures_C=np.array([60.0]), velocities=np.zeros((1, 3)),
+                            radii=np.full(1, 0.004))
+    (tmp_path / "bed").mkdir()
+    (tmp_path / "bed" / "log.simpleFoam").write_text("Time = 1\nTime = 2\nEnd\n")
+    with pytest.raises(AnalysisInputError) as err:
+        solve_bed_heat(None, state, SimpleNamespace(), SimpleNamespace(),  # type: ignore[arg-type]
+                       tmp_path)
+    assert err.value.name == str(tmp_path / "bed")
