@@ -30,8 +30,8 @@ if TYPE_CHECKING:
     from drumflow.physics.exchanger import ExchangerResult
 
 __all__ = ["PAPER_TABLE7", "DrumInputs", "PlantFromSlice", "PlantFromSliceFiles",
-           "curtain_air_from_slice", "curtain_air_setting", "plant_from_slice", "plot_curtain_air",
-           "plot_drum", "slice_closures", "write_plant_from_slice"]
+           "curtain_air_from_slice", "curtain_air_setting", "is_slice_file", "plant_from_slice",
+           "plot_curtain_air", "plot_drum", "slice_closures", "write_plant_from_slice"]
 
 #: Table 7 of the paper, model one: its exchanger prediction of the plant.
 PAPER_TABLE7 = {"material_outlet_C": 40.90, "air_outlet_C": 69.73}
@@ -115,6 +115,12 @@ def curtain_air_from_slice(path: Path) -> float:
     return flow
 
 
+def is_slice_file(value: str) -> bool:
+    """Whether a ``--curtain-air`` value names a slice's file (one rule for reading it and
+    for recording where the flow came from)."""
+    return value.strip().endswith(".json")
+
+
 def curtain_air_setting(value: str) -> float | None:
     """``--curtain-air``: 'all' (None), a flow in m3/s per metre of drum, or a periodic slice's
     ``heat.json`` (:func:`curtain_air_from_slice`).
@@ -128,7 +134,7 @@ def curtain_air_setting(value: str) -> float | None:
                "periodic slice's heat.json")
     if value.strip().lower() == "all":
         return None
-    if value.strip().endswith(".json"):
+    if is_slice_file(value):
         return curtain_air_from_slice(Path(value.strip()))
     try:
         flow = float(value)
@@ -340,7 +346,7 @@ def plant_from_slice(source: Path, *, cells: int = 40, rpm: float | None = None,
         result=result, wall_s=wall,
         warnings=extrapolation_warnings(plant, base, closures, result.scaled) + result.warnings,
         textbook_ua=ua, textbook=textbook, exchanger=paper_exchanger(plant), curtain_air=curtain_flow,
-        curtain_air_from=curtain_air.strip() if curtain_air.strip().endswith(".json") else None)
+        curtain_air_from=curtain_air.strip() if is_slice_file(curtain_air) else None)
     # The through-curtain flow is the closure no slice measures yet: show what it changes.
     if sweep:
         evaluation.points = sweep_curtain_air(plant, closures, law, options)
