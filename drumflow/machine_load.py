@@ -180,3 +180,21 @@ def _stretch(rows: list[int], times: NDArray[np.float64], other: NDArray[np.floa
     weights = spans[rows]
     return (float(times[rows[0]] - spans[rows[0]]), float(times[rows[-1]]),
             float((other[rows] * weights).sum() / weights.sum()))
+
+
+def contended_share(run: Path) -> float:
+    """The share of a run's logged wall time that other programs contended.
+
+    ``run`` is a run directory (its log in ``dem/``) or a shipped results folder (the log at
+    its top). NaN where the run has no load log (runs older than the log) or an empty one: not
+    known, which a table must not print as zero.
+    """
+    for path in (run / "dem" / "machine_load.csv", run / "machine_load.csv"):
+        if path.is_file():
+            table = read_load_log(path)
+            if table.empty:
+                return math.nan
+            logged = float(sample_spans(table["time_unix"].to_numpy(float)).sum())
+            contended = sum(end - start for start, end, _ in contended_stretches(table))
+            return contended / logged
+    return math.nan

@@ -57,6 +57,7 @@ from drumflow.bench.answer import (
 )
 from drumflow.bench.answer_result import AnswerReplay, path_from
 from drumflow.errors import CaseError
+from drumflow.machine_load import contended_share
 from drumflow.readers import read_text
 
 if TYPE_CHECKING:
@@ -198,7 +199,9 @@ class AnswerLadder:
     table
         One row per rung: ``rung``, ``description``, ``stop``, ``stop_time_s`` (NaN: the rung
         never reaches the answer), ``wall_s``, ``wall_estimated`` (scaled or partly from a
-        rate), ``speedup`` (the reference's wall over this rung's), per quantity ``value_Q``
+        rate), ``contended_share`` (the share of the run's logged wall time other programs
+        contended, :func:`drumflow.machine_load.contended_share`; NaN: the run has no load log),
+        ``speedup`` (the reference's wall over this rung's), per quantity ``value_Q``
         and ``error_Q`` (relative to the reference), ``max_error`` over the answers,
         ``within_tolerance``, ``note``.
     reference_values
@@ -337,6 +340,8 @@ def answer_ladder(spec: LadderSpec) -> AnswerLadder:
             "stop_time_s": math.nan if t is None else t, "run_end_s": replay.reference_time_s,
             "wall_s": wall_s,
             "wall_estimated": bool(rung.wall_scale != 1.0 or share > 0.0),
+            # A wall time measures the settings only on a machine the run had to itself.
+            "contended_share": contended_share(rung.run),
             "speedup": (reference_wall / wall_s if reference_wall and wall_s == wall_s
                         and wall_s > 0 else math.nan),
         }

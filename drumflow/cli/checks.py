@@ -427,7 +427,7 @@ def ladder(
     table = Table(title=f"{result.spec.title} (errors against '{result.spec.reference}'; "
                   f"answer known within ±{result.spec.tolerance:.0%})", box=box.SIMPLE,
                   padding=(0, 1))
-    for title in ("rung", "stop", "at s", "wall h", "faster",
+    for title in ("rung", "stop", "at s", "wall h", "contended", "faster",
                   *(f"Δ {LADDER_QUANTITIES[q].short}" for q in answers), "known"):
         table.add_column(title, justify="left" if title in ("rung", "stop") else "right")
     for _, row in result.table.iterrows():
@@ -435,6 +435,8 @@ def ladder(
         cells = [row["rung"], row["stop"],
                  "never" if row["stop_time_s"] != row["stop_time_s"] else f"{row['stop_time_s']:.3g}",
                  "-" if wall != wall else f"{wall / 3600:.2f}{'*' if row['wall_estimated'] else ''}",
+                 "-" if row["contended_share"] != row["contended_share"]
+                 else f"{row['contended_share']:.0%}",
                  "-" if row["speedup"] != row["speedup"] else f"{row['speedup']:.2f}×",
                  *(f"{row[f'error_{q}']:+.2%}" for q in answers),
                  "yes" if row["within_tolerance"] else "no"]
@@ -442,7 +444,9 @@ def ladder(
     console.print(table)
     floor = ", ".join(f"{q} ±{result.noise_floor[q]:.2%}" for q in answers)
     console.print(f"noise floor (the reference's half-widths): {floor}; "
-                  "* wall time estimated (scaled or partly from a rate)", highlight=False)
+                  "* wall time estimated (scaled or partly from a rate); contended: the share "
+                  "of the run's logged wall time other programs took a core's tenth or more "
+                  "(- no load log), a speed result only near 0 %", highlight=False)
     for _, row in result.table.iterrows():
         console.print(f"{row['rung']}: {row['note']}", highlight=False)
     console.print("written: " + ", ".join(str(p) for p in paths.values()), highlight=False)

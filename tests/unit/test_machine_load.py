@@ -3,6 +3,7 @@ programs', and the stretches where others took the machine."""
 
 from __future__ import annotations
 
+import math
 import subprocess
 import sys
 import time
@@ -11,7 +12,14 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
-from drumflow.machine_load import COLUMNS, LoadLog, contended_stretches, read_load_log, session_cpu_s
+from drumflow.machine_load import (
+    COLUMNS,
+    LoadLog,
+    contended_share,
+    contended_stretches,
+    read_load_log,
+    session_cpu_s,
+)
 
 BURN = "import time\nt = time.time()\nwhile time.time() - t < {s}: pass"
 
@@ -67,3 +75,21 @@ def test_a_file_that_is_not_a_load_log_is_refused(tmp_path: Path) -> None:
         read_load_log(path)
     with pytest.raises(ValueError, match="period = 0"):
         LoadLog(tmp_path / "x.csv", 1, period=0.0)
+
+
+def test_contended_share_of_a_run_or_a_shipped_folder(tmp_path: Path) -> None:
+    t0 = 1.0e9
+    # First sample covers 3 s, then nine of 30 s: 273 s logged; samples 3-4 contended (60 s).
+    other = [0.0, 0.0, 0.0, 0.5, 0.9, 0.0, 0.0, 0.0, 0.0, 0.0]
+    table = pd.DataFrame({"time_unix": [t0 + 30 * i for i in range(10)], "load_1min": 2.0,
+                          "busy_cores": 2.0, "run_cores": 2.0, "other_cores": other})
+    run = tmp_path / "run"
+    (run / "dem").mkdir(parents=True)
+    table.to_csv(run / "dem" / "machine_load.csv", index=False)
+    assert contended_share(run) == pytest.approx(60 / 273)
+    shipped = tmp_path / "shipped"
+    shipped.mkdir()
+    table.assign(other_cores=0.0).to_csv(shipped / "machine_load.csv", index=False)
+    assert contended_share(shipped) == 0.0
+    # No log: not known, never zero.
+    assert math.isnan(contended_share(tmp_path))
