@@ -3,6 +3,10 @@
 # own "auto" step, to 17.5 s, in the background, on any machine, across sessions.
 #
 #   bash studies/reference_run.sh            # start, or go on from where it stands
+#   bash studies/reference_run.sh --fast     # the candidate: the same case under the fast
+#                                            # profile (`drumflow run --fast`: contact step, no
+#                                            # dashpot, no conduction, the converged stop live),
+#                                            # in model_two_fast/, shipped beside the reference
 #   drumflow status /var/tmp/drumflow-runs/reference/model_two
 #   drumflow stop   /var/tmp/drumflow-runs/reference/model_two   # a restart, then exit 130
 #
@@ -22,8 +26,15 @@ set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 root="${DRUMFLOW_REFERENCE_ROOT:-/var/tmp/drumflow-runs/reference}"
-run="$root/model_two"
-shipped="$here/results/bench/reference/model_two"
+name="model_two"
+profile=()
+case "${1:-}" in
+  "") ;;
+  --fast) name="model_two_fast"; profile=(--fast) ;;
+  *) echo "reference_run.sh: unknown option ${1}; allowed: --fast" >&2; exit 2 ;;
+esac
+run="$root/$name"
+shipped="$here/results/bench/reference/$name"
 mkdir -p "$root"
 cd "$here"
 
@@ -33,13 +44,15 @@ if [ ! -f "$run/manifest.json" ]; then
   if [ -n "$latest" ]; then
     # The shipped case with the shipped state as its start (an absolute path: the case copy
     # lives outside the work tree).
-    case_file="$root/paper_model_two_from_state.toml"
+    case_file="$root/${name}_from_state.toml"
     sed "s|^\[run\]|[run]\nstart_state = \"$latest\"|" cases/paper_model_two.toml > "$case_file"
     [ -f "$shipped/joins.csv" ] || echo "joined_utc,state" > "$shipped/joins.csv"
     echo "$(date -u +%FT%TZ),$(basename "$latest")" >> "$shipped/joins.csv"
     echo "reference: a fresh machine; going on from the shipped $latest" >&2
   fi
-elif [ -f "$root/paper_model_two_from_state.toml" ]; then
-  case_file="$root/paper_model_two_from_state.toml"
+elif [ -f "$root/${name}_from_state.toml" ]; then
+  case_file="$root/${name}_from_state.toml"
+elif [ -f "$root/paper_model_two_from_state.toml" ] && [ "$name" = "model_two" ]; then
+  case_file="$root/paper_model_two_from_state.toml"  # the name before --fast existed
 fi
-exec .venv/bin/drumflow run "$case_file" --out "$run"
+exec .venv/bin/drumflow run "$case_file" "${profile[@]}" --out "$run"

@@ -3,6 +3,7 @@
 # full snapshot as a packed state, and its small results, into results/bench/reference/model_two/.
 #
 #   bash studies/ship_reference.sh            # the run may be running or stopped
+#   bash studies/ship_reference.sh --fast     # the fast candidate (reference_run.sh --fast)
 #
 # The state (about 15 MB for 299,164 particles) replaces the one shipped before (git keeps the
 # history); the series come from `drumflow post` and studies/ship_paper_run.py (no dumps, no
@@ -10,8 +11,14 @@
 # 0.5 s simulated).
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-run="${DRUMFLOW_REFERENCE_ROOT:-/var/tmp/drumflow-runs/reference}/model_two"
-dest="$here/results/bench/reference/model_two"
+name="model_two"
+case "${1:-}" in
+  "") ;;
+  --fast) name="model_two_fast" ;;  # the candidate of `reference_run.sh --fast`
+  *) echo "ship_reference.sh: unknown option ${1}; allowed: --fast" >&2; exit 2 ;;
+esac
+run="${DRUMFLOW_REFERENCE_ROOT:-/var/tmp/drumflow-runs/reference}/$name"
+dest="$here/results/bench/reference/$name"
 cd "$here"
 [ -f "$run/manifest.json" ] || { echo "ship_reference: no run at $run" >&2; exit 2; }
 mkdir -p "$dest"
