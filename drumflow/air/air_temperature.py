@@ -41,11 +41,12 @@ import shutil
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, cast
+from typing import TYPE_CHECKING, Any, ClassVar, cast
 
 import numpy as np
 from numpy.typing import NDArray
 
+from drumflow.air.solids_fraction import CellZones
 from drumflow.errors import AnalysisInputError
 
 if TYPE_CHECKING:
@@ -60,7 +61,7 @@ MAX_ITERATIONS = 10_000
 
 
 @dataclass(frozen=True)
-class HeatZones:
+class HeatZones(CellZones):
     """Source cells binned: ``cells`` per zone, its ``k`` (1/s) and ``theta_p`` (K over the
     inlet); ``cell_k``, ``cell_theta_p``: the exact per-cell values."""
 
@@ -70,15 +71,11 @@ class HeatZones:
     cell_k: NDArray[np.float64] = field(repr=False)
     cell_theta_p: NDArray[np.float64] = field(repr=False)
 
-    @property
-    def names(self) -> list[str]:
-        return [f"heat{i}" for i in range(len(self.cells))]
+    stem: ClassVar[str] = "heat"
 
     def binned(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Each cell's zone k and theta_p (0 outside every zone)."""
-        k, t = np.zeros_like(self.cell_k), np.zeros_like(self.cell_k)
-        for i, c in enumerate(self.cells):
-            k[c], t[c] = self.k[i], self.theta_p[i]
+        k, t = self.spread(self.cell_k, self.k, self.theta_p)
         return k, t
 
 
@@ -262,8 +259,6 @@ def _write_heat_case(heat_dir: Path, zones: HeatZones, diffusivity: NDArray[np.f
     from foamlib import FoamFieldFile, FoamFile
 
     from drumflow.air.foam_case import write_field, write_zone_sets
-    from drumflow.air.solids_fraction import PorosityZones
-
     names = [n for n, _ in cast(list[tuple[str, Any]],
                                 FoamFile(heat_dir / "constant/polyMesh/boundary")[None])]
     bc: dict[str, dict[str, Any]] = {n: {"type": "zeroGradient"} for n in names}
@@ -327,10 +322,8 @@ def _write_heat_case(heat_dir: Path, zones: HeatZones, diffusivity: NDArray[np.f
     with FoamFile(heat_dir / "constant" / "transportProperties") as f:
         f["DT"] = FoamFile.Dimensioned(0.0, FoamFile.DimensionSet(length=2, time=-1), "DT")
     # No system/fvOptions: the sources act on theta, inside its function object.
-    # write_zone_sets takes the cell lists of a PorosityZones; its d and f are not written.
     # Named at once: parsing the written dictionary again took minutes on 150k cells.
-    write_zone_sets(heat_dir, PorosityZones(zones.cells, zones.k, zones.theta_p, zones.cell_k,
-                                            zones.cell_theta_p), zones.names)
+    write_zone_sets(heat_dir, zones, zones.names)
 
 
 def _write(path: Path, entries: dict[str, Any]) -> None:

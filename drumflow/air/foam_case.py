@@ -40,7 +40,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
-    from drumflow.air.solids_fraction import PorosityZones
+    from drumflow.air.solids_fraction import CellZones
     from drumflow.case import Case
 
 #: k-epsilon model constant C_mu (standard value) for the inlet epsilon.
@@ -361,7 +361,7 @@ def write_decompose_dict(case_dir: Path, processes: int, axis: int = 0) -> None:
 
 # -- porosity zones (drumflow.air.bed_air, drumflow.verify.porous_foam) ----------------
 
-def write_zone_sets(case_dir: Path, zones: PorosityZones, names: list[str] | None = None,
+def write_zone_sets(case_dir: Path, zones: CellZones, names: list[str] | None = None,
                     ) -> None:
     """``system/topoSetDict``: one cellZoneSet per zone, from its cell list, named ``names``
     (default the zones' own)."""

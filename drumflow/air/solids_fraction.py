@@ -55,7 +55,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -303,8 +303,34 @@ class ErgunLaw:
 ERGUN = ErgunLaw()
 
 
+class CellZones:
+    """Cells binned into zones with one value pair per zone: what a ``topoSetDict`` writes
+    (:func:`drumflow.air.foam_case.write_zone_sets`) and what its cells get back.
+
+    A subclass is a dataclass with ``cells`` (the flattened cell indices of each zone) and sets
+    ``stem``, the zones' name without their index.
+    """
+
+    cells: list[NDArray[np.int64]]
+    stem: ClassVar[str] = "zone"
+
+    @property
+    def names(self) -> list[str]:
+        """The cellZone names: the stem and the zone's index."""
+        return [f"{self.stem}{i}" for i in range(len(self.cells))]
+
+    def spread(self, like: NDArray[np.float64], *per_zone: NDArray[np.float64]
+               ) -> tuple[NDArray[np.float64], ...]:
+        """Each per-zone array as a cell field shaped as ``like`` (0 outside every zone)."""
+        out = tuple(np.zeros_like(like) for _ in per_zone)
+        for i, c in enumerate(self.cells):
+            for field_, values in zip(out, per_zone, strict=True):
+                field_[c] = values[i]
+        return out
+
+
 @dataclass
-class PorosityZones:
+class PorosityZones(CellZones):
     """Cells binned into porosity zones with one Darcy-Forchheimer pair each.
 
     Attributes
@@ -324,15 +350,11 @@ class PorosityZones:
     cell_d: NDArray[np.float64]
     cell_f: NDArray[np.float64]
 
-    @property
-    def names(self) -> list[str]:
-        return [f"bed{i}" for i in range(len(self.cells))]
+    stem: ClassVar[str] = "bed"
 
     def binned(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """The coefficients every cell gets from its zone (0 outside every zone)."""
-        d, f = np.zeros_like(self.cell_d), np.zeros_like(self.cell_f)
-        for i, c in enumerate(self.cells):
-            d[c], f[c] = self.d[i], self.f[i]
+        d, f = self.spread(self.cell_d, self.d, self.f)
         return d, f
 
     def binning_error(self, volumes: NDArray[np.float64] | None = None) -> dict[str, float]:
