@@ -27,6 +27,7 @@ SMOKE = "docs/smoke/smoke_bench_results.csv"
 PLANT = "docs/plant/paper_model_one_plant.json"
 SPIN = "results/bench/paper_model_two_spin/ladder.csv"
 CG_LADDER = "results/bench/paper_model_two_ladder/ladder.csv"
+MEASURED = "results/bench/paper_model_two_ladder_measured/ladder.csv"
 
 #: (text typed in the README with its number in brackets, file, key, format). The text without
 #: the brackets is searched as it stands in a sentence; the value read from the file, formatted,
@@ -57,6 +58,9 @@ TYPED: list[tuple[str, str, str, str]] = [
     ("flow by [5.4] %", SPIN, "default_step.error_steady_mass_flow", ".1%"),
     ("heat answer to\n  [0.35] %", CG_LADDER, "parcels.error_h", ".2%"),
     ("flow by [7.5] %", CG_LADDER, "parcels.error_steady_mass_flow", ".1%"),
+    ("cascading flow is\n  [5.8] % high", MEASURED, "old_defaults.error_steady_mass_flow", ".1%"),
+    ("the reference at\n  [14.0] s within", MEASURED, "reference_rule.stop_time_s", ".1f"),
+    ("within [0.08] % of its end", MEASURED, "reference_rule.error_steady_mass_flow", ".2%"),
 ]
 
 
