@@ -1,9 +1,11 @@
 #!/usr/bin/env bash
 # Ship what must outlive the machine of the reference run (studies/reference_run.sh): its newest
-# full snapshot as a packed state, and its small results, into results/bench/reference/model_two/.
+# full snapshot as a packed state, and its small results, into
+# results/bench/reference/model_<one|two>[_fast]/.
 #
 #   bash studies/ship_reference.sh            # the run may be running or stopped
 #   bash studies/ship_reference.sh --fast     # the fast candidate (reference_run.sh --fast)
+#   bash studies/ship_reference.sh --model one [--fast]   # paper model one's
 #
 # The state (about 15 MB for 299,164 particles) replaces the one shipped before (git keeps the
 # history); the series come from `drumflow post` and studies/ship_paper_run.py (no dumps, no
@@ -11,12 +13,19 @@
 # 0.5 s simulated).
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-name="model_two"
-case "${1:-}" in
-  "") ;;
-  --fast) name="model_two_fast" ;;  # the candidate of `reference_run.sh --fast`
-  *) echo "ship_reference.sh: unknown option ${1}; allowed: --fast" >&2; exit 2 ;;
-esac
+model="two"
+fast=""
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --fast) fast="_fast" ;;  # the candidate of `reference_run.sh --fast`
+    --model)
+      model="${2:-}"; shift
+      case "$model" in one|two) ;; *) echo "ship_reference.sh: --model ${model:-(none)}; allowed: one, two" >&2; exit 2 ;; esac ;;
+    *) echo "ship_reference.sh: unknown option $1; allowed: --fast, --model one|two" >&2; exit 2 ;;
+  esac
+  shift
+done
+name="model_${model}${fast}"
 run="${DRUMFLOW_REFERENCE_ROOT:-/var/tmp/drumflow-runs/reference}/$name"
 dest="$here/results/bench/reference/$name"
 cd "$here"

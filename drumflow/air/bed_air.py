@@ -64,7 +64,7 @@ if TYPE_CHECKING:
 __all__ = ["BED_FRACTION", "CURTAIN_FRACTION", "POROUS_FRACTION", "AirMeasure", "BedAirResult",
            "BedSnapshot", "CellDeposit", "PolyMesh", "categorize", "deposit_on_cells", "deposit_state",
            "inflow_into", "measure_air", "porosity_zones", "read_poly_mesh", "section_flow", "solve_bed_air",
-           "write_bed_air", "write_porosity_options"]
+           "write_bed_air"]
 
 #: Cells with at least this solids fraction are bed cells.
 BED_FRACTION = 0.3
@@ -400,30 +400,6 @@ def porosity_zones(fraction: NDArray[np.float64], volumes: NDArray[np.float64], 
     return PorosityZones(cells, np.array(d), np.array(f), cell_d, cell_f)
 
 
-def write_porosity_options(case_dir: Path, zones: PorosityZones) -> None:
-    """``system/topoSetDict`` (the zones' cellZoneSets) and ``system/fvOptions``: one
-    ``explicitPorositySource`` (DarcyForchheimer) per zone, as stock simpleFoam v1912 reads it."""
-    from foamlib import FoamFile
-
-    from drumflow.air.foam_case import darcy_forchheimer_coeffs, write_zone_sets
-
-    write_zone_sets(case_dir, zones)
-    options = case_dir / "system" / "fvOptions"
-    options.unlink(missing_ok=True)
-    with FoamFile(options) as f:
-        for name, d, fc in zip(zones.names, zones.d, zones.f, strict=True):
-            f[name] = {
-                "type": "explicitPorositySource",
-                "active": True,
-                "explicitPorositySourceCoeffs": {
-                    "selectionMode": "cellZone",
-                    "cellZone": name,
-                    "type": "DarcyForchheimer",
-                    "DarcyForchheimerCoeffs": darcy_forchheimer_coeffs(float(d), float(fc)),
-                },
-            }
-
-
 def deposit_state(case: Case, state: BedSnapshot, mesh: PolyMesh,
                   cells: dict[str, NDArray[np.float64]], spacing: float | None = None,
                   ) -> CellDeposit:
@@ -481,7 +457,7 @@ def solve_bed_air(
         A grid spacing that fills a cell with solids.
     """
     from drumflow.air.foam import solve_air
-    from drumflow.air.foam_case import air_properties_for, write_fv_solution
+    from drumflow.air.foam_case import air_properties_for, write_fv_solution, write_porosity
     from drumflow.air.foam_results import read_cell_fields
     from drumflow.air.mesh import run_foam
 
@@ -513,7 +489,7 @@ def solve_bed_air(
             source = empty.case_dir / empty.time_dir / name
             if source.exists():
                 shutil.copyfile(source, bed_dir / "0" / name)
-        write_porosity_options(bed_dir, zones)
+        write_porosity(bed_dir, zones, "fvOptions")
         # Plain SIMPLE: with porosity SIMPLEC's residuals stall in this build (a drum full of
         # porosity: p at 8e-3 for 2000 iterations; SIMPLE converged in 133, same gradient).
         write_fv_solution(bed_dir, case.air.residual_target, fields, consistent=False)

@@ -37,10 +37,10 @@ dictionaries are written with foamlib.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Literal
 
 if TYPE_CHECKING:
-    from drumflow.air.solids_fraction import CellZones
+    from drumflow.air.solids_fraction import CellZones, PorosityZones
     from drumflow.case import Case
 
 #: k-epsilon model constant C_mu (standard value) for the inlet epsilon.
@@ -389,6 +389,30 @@ def darcy_forchheimer_coeffs(d: float, f: float) -> dict[str, Any]:
                                    "e2": [0.0, 1.0, 0.0]},
         },
     }
+
+
+def write_porosity(case_dir: Path, zones: PorosityZones,
+                   host: Literal["fvOptions", "porosityProperties"]) -> None:
+    """``system/topoSetDict`` (the zones' cellZoneSets) and one isotropic DarcyForchheimer
+    resistance per zone, where the solver reads it: ``system/fvOptions`` as an
+    ``explicitPorositySource`` (stock simpleFoam v1912, the bed-air cases), or
+    ``constant/porosityProperties`` (porousSimpleFoam, the verification's porous bed)."""
+    from foamlib import FoamFile
+
+    write_zone_sets(case_dir, zones)
+    path = case_dir / ("system" if host == "fvOptions" else "constant") / host
+    path.unlink(missing_ok=True)
+    with FoamFile(path) as f:
+        for name, d, fc in zip(zones.names, zones.d, zones.f, strict=True):
+            coeffs = darcy_forchheimer_coeffs(float(d), float(fc))
+            if host == "fvOptions":
+                f[name] = {"type": "explicitPorositySource", "active": True,
+                           "explicitPorositySourceCoeffs": {
+                               "selectionMode": "cellZone", "cellZone": name,
+                               "type": "DarcyForchheimer", "DarcyForchheimerCoeffs": coeffs}}
+            else:  # porosityProperties takes the model itself, without selectionMode
+                f[name] = {"type": "DarcyForchheimer", "active": True, "cellZone": name,
+                           "DarcyForchheimerCoeffs": coeffs}
 
 
 # -- the whole case ---------------------------------------------------------------------

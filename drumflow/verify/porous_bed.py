@@ -55,7 +55,7 @@ from pathlib import Path
 import numpy as np
 from scipy.optimize import brentq
 
-from drumflow.air.foam_case import write_field
+from drumflow.air.foam_case import write_field, write_porosity
 from drumflow.air.solids_fraction import (
     ERGUN,
     ErgunLaw,
@@ -76,7 +76,6 @@ from drumflow.verify.porous_foam import (
     solve_bed_air,
     write_block_mesh,
     write_numerics,
-    write_porosity,
 )
 
 #: Air cell size in particle diameters: 2 d cells hold ~9 spheres, so the deposited fraction
@@ -173,7 +172,7 @@ def run_bed_column(work: Path, runner: Runner, bed: PackedBed, law: ErgunLaw = E
     fraction = grid.flatten(deposition.fraction)[grid.locate(centres)]
     volumes = grid.flatten(grid.cell_volumes)[grid.locate(centres)]
     zones = bin_coefficients(fraction, volumes, d, bins=bins, law=law)
-    write_porosity(case_dir, zones)
+    write_porosity(case_dir, zones, "porosityProperties")
     cyclic = {"type": "cyclic"}
     write_field(case_dir, "U", {"length": 1, "time": -1}, [0.0, 0.0, velocity], {
         "inlet": {"type": "fixedValue", "value": [0.0, 0.0, velocity]},
@@ -354,7 +353,7 @@ def run_flow_split(work: Path, runner: Runner, bed: PackedBed, law: ErgunLaw = E
     cell_volumes[in_bed] = grid.flatten(grid.cell_volumes)[index[in_bed]]
     cell_volumes[~in_bed] = length * width * half / np.prod(open_cells)
     zones = bin_coefficients(fraction, cell_volumes, d, bins=bins, law=law)
-    write_porosity(case_dir, zones)
+    write_porosity(case_dir, zones, "porosityProperties")
     cyclic = {"type": "cyclic"}
     write_field(case_dir, "U", {"length": 1, "time": -1}, [0.0, 0.0, 0.0], {
         '"(bed|open)_walls"': {"type": "noSlip"}, '"(bed|open)_x(lo|hi)"': cyclic})

@@ -2,7 +2,8 @@
 ``porousSimpleFoam`` cases of air through a bed's porosity zones.
 
 Each case is written from scratch: a ``blockMesh`` of axis-aligned boxes (:func:`write_block_mesh`),
-one ``DarcyForchheimer`` porosity model per zone (:func:`write_porosity`), plain SIMPLE numerics
+one ``DarcyForchheimer`` porosity model per zone (``drumflow.air.foam_case.write_porosity``),
+plain SIMPLE numerics
 (:func:`write_numerics`) and the initial fields (:func:`drumflow.air.foam_case.write_field`);
 :func:`solve_bed_air` runs ``topoSet`` and ``porousSimpleFoam`` and reads the cells back.
 """
@@ -17,7 +18,6 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from drumflow.air.foam_case import darcy_forchheimer_coeffs, write_zone_sets
 from drumflow.air.solids_fraction import PorosityZones
 from drumflow.errors import AirNotConvergedError
 from drumflow.runner import Runner
@@ -26,13 +26,10 @@ __all__ = [
     "AirOfBed",
     "air_at",
     "cell_order",
-    "darcy_forchheimer_coeffs",
     "fresh_case",
     "solve_bed_air",
     "write_block_mesh",
     "write_numerics",
-    "write_porosity",
-    "write_zone_sets",
 ]
 
 #: Air at 30 C and 1 atm (drumflow's air table).
@@ -117,24 +114,6 @@ def write_block_mesh(case_dir: Path, blocks: list[dict[str, Any]]) -> None:
     )
     (case_dir / "system").mkdir(parents=True, exist_ok=True)
     (case_dir / "system" / "blockMeshDict").write_text(text)
-
-
-def write_porosity(case_dir: Path, zones: PorosityZones) -> None:
-    """``system/topoSetDict`` (one cellZoneSet per zone, from its cell list) and
-    ``constant/porosityProperties`` (one DarcyForchheimer model per zone)."""
-    from foamlib import FoamFile
-
-    write_zone_sets(case_dir, zones)
-    props = case_dir / "constant" / "porosityProperties"
-    props.unlink(missing_ok=True)
-    with FoamFile(props) as f:
-        for name, d, fc in zip(zones.names, zones.d, zones.f, strict=True):
-            f[name] = {
-                "type": "DarcyForchheimer",
-                "active": True,
-                "cellZone": name,
-                "DarcyForchheimerCoeffs": darcy_forchheimer_coeffs(float(d), float(fc)),
-            }
 
 
 def write_numerics(case_dir: Path, nu: float, reference_cell: bool,

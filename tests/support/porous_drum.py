@@ -10,8 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
-from drumflow.air.bed_air import write_porosity_options
-from drumflow.air.foam_case import write_fv_solution
+from drumflow.air.foam_case import write_fv_solution, write_porosity
 from drumflow.air.mesh import run_foam
 from drumflow.air.solids_fraction import PorosityZones
 from drumflow.case import Case, case_from_dict
@@ -43,7 +42,7 @@ def full_of_porosity(case: Case, runner: Runner, d: float, f: float) -> Callable
         n = int(np.asarray(FoamFile(work / "constant/polyMesh/owner")[None]).max()) + 1
         zones = PorosityZones([np.arange(n)], np.array([d]), np.array([f]), np.full(n, d),
                               np.full(n, f))
-        write_porosity_options(work, zones)
+        write_porosity(work, zones, "fvOptions")
         write_fv_solution(work, case.air.residual_target, ["p", "U", "k", "epsilon"],
                           consistent=False)
         run_foam(runner, "topoSet", [], work, timeout=60)

@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -135,3 +136,29 @@ def test_binning_keeps_the_volume_mean_resistance_and_reports_its_spread() -> No
     assert exact.binning_error(volumes)["d_max"] < 1e-12
     with pytest.raises(ValueError):
         bin_coefficients(np.array([1.0]), np.array([1.0]), 4e-3)
+
+
+def test_one_porosity_writer_for_both_hosts(tmp_path: Path) -> None:
+    """The bed-air cases (fvOptions) and the verification's porous bed (porosityProperties) read
+    the same zones and coefficients from one writer (they were twins until 2026-11-28)."""
+    from foamlib import FoamFile
+
+    from drumflow.air.foam_case import write_porosity
+
+    zones = bin_coefficients(np.r_[np.full(5, 0.6), np.full(5, 0.3), np.zeros(3)],
+                             np.full(13, 1e-9), 4e-3, bins=2)
+    for sub in ("system", "constant"):
+        (tmp_path / sub).mkdir()
+    write_porosity(tmp_path, zones, "fvOptions")
+    write_porosity(tmp_path, zones, "porosityProperties")
+    options = FoamFile(tmp_path / "system" / "fvOptions")
+    props = FoamFile(tmp_path / "constant" / "porosityProperties")
+    for name, d, f in zip(zones.names, zones.d, zones.f, strict=True):
+        inner = options[name, "explicitPorositySourceCoeffs"]
+        assert options[name, "type"] == "explicitPorositySource"
+        assert inner["cellZone"] == props[name, "cellZone"] == name
+        for coeffs in (inner["DarcyForchheimerCoeffs"], props[name, "DarcyForchheimerCoeffs"]):
+            assert list(coeffs["d"]) == pytest.approx([d] * 3)
+            assert list(coeffs["f"]) == pytest.approx([f] * 3)
+    sets = FoamFile(tmp_path / "system" / "topoSetDict")["actions"]
+    assert [a["name"] for a in sets] == zones.names
