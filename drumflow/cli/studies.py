@@ -225,8 +225,9 @@ def validate(
         Path, typer.Option("--out", "-o", help="where the runs, validation.json, CSVs and plots go")
     ] = Path("runs/validate"),
     scale: Annotated[
-        str | None, typer.Option("--scale", help="small (minutes, a check of the chain), section "
-                                 "(periodic section, the comparison) or full (the whole drum)")
+        str | None, typer.Option("--scale", help="the scene's scale (--list names them; default the "
+                                 "first): rolling_drum small|section|full, particle_curtain "
+                                 "parcels|short|finer")
     ] = None,
     timeout: Annotated[float | None, typer.Option("--timeout", min=1, help="solver time limit, s")] = None,
 ) -> None:
@@ -249,19 +250,50 @@ def validate(
     output_folder(out)
     with StageProgress(err_console) as progress:
         record = run_validation(name, out, scale, timeout=timeout, progress=progress)
-    table = Table(title=f"drumflow validate {name} ({record['scale']})")
+    if "experiments" in record:
+        console.print(_curtain_table(record))
+    else:
+        console.print(_profile_table(record))
+    console.print(f"written: {out / 'validation.json'}, {out / record['csv']}, {out / record['plot']}",
+                  highlight=False)
+
+
+def _num(v: Any) -> str:
+    return "n/a" if v is None else f"{v:.4g}"
+
+
+def _profile_table(record: dict[str, Any]) -> Table:
+    """The rolling drum's observables against the measured ones."""
+    table = Table(title=f"drumflow validate {record['scene']} ({record['scale']})")
     for col in ("observable", "simulated", "measured", "error", "band", ""):
         table.add_column(col, justify="right" if col not in ("observable", "") else "left")
     for key, m in record["comparison"].items():
-        def num(v: Any) -> str:
-            return "n/a" if v is None else f"{v:.4g}"
         err = m["error"]
         err_text = "n/a" if err is None else (f"{100 * err:+.1f} %" if m["error_kind"] == "relative"
                                               else f"{1e3 * err:+.1f} mm")
         band = f"{100 * m['band']:g} %" if m["error_kind"] == "relative" else f"{1e3 * m['band']:g} mm"
-        table.add_row(key, num(m["simulated"]), num(m["measured"]), err_text, band,
+        table.add_row(key, _num(m["simulated"]), _num(m["measured"]), err_text, band,
                       "[green]within[/]" if m["within_band"] else "[bold red]outside[/]")
-    console.print(table)
-    console.print(f"written: {out / 'validation.json'}, {out / record['csv']}, {out / record['plot']}",
-                  highlight=False)
+    return table
+
+
+def _curtain_table(record: dict[str, Any]) -> Table:
+    """The curtain's experiments: the DEM's answer beside the reduced-order model's."""
+    table = Table(title=f"drumflow validate {record['scene']} ({record['scale']}): CFD-DEM / "
+                  "reduced-order model")
+    for col in ("experiment", "duty W", "solids out °C", "gas out °C", "speed at floor m/s",
+                "drift m", "bookkeeping", "wall s"):
+        table.add_column(col, justify="left" if col == "experiment" else "right")
+    for r in record["experiments"]:
+        dem, rom = r["dem"], r["reduced_order"]
+
+        def pair(key: str, dem: dict[str, Any] = dem, rom: dict[str, Any] = rom) -> str:
+            return f"{_num(dem[key])} / {_num(rom[key])}"
+        book = dem["bookkeeping"]
+        closes = (f"{int(book['fed']):,} fed, {int(book['count_residual'])} missing, "
+                  f"energy {book['energy_residual']:.1e}")
+        table.add_row(r["experiment"], pair("heat_duty_W"), pair("solids_outlet_C"),
+                      pair("gas_outlet_C"), pair("outlet_speed_m_s"), pair("outlet_drift_m"), closes,
+                      f"{r['wall_time_s']:.0f}")
+    return table
 

@@ -39,7 +39,7 @@ from drumflow.coupling.mpi import allreduce_sum
 if TYPE_CHECKING:
     from drumflow.coupling.library import Liggghts
 
-__all__ = ["CONTACT_COMPUTE", "CROSSINGS_RECORD", "CrossingTracker", "downward_crossings",
+__all__ = ["CONTACT_COMPUTE", "CROSSINGS_RECORD", "CrossingTracker", "atom_ids", "downward_crossings",
            "read_loop_crossings"]
 
 #: The loop's crossing table, relative to the DEM working directory.
@@ -110,7 +110,7 @@ def read_loop_crossings(path: Path) -> pd.DataFrame:
     return table.iloc[np.argsort(table["time"].to_numpy(), kind="stable")].reset_index(drop=True)
 
 
-def _atom_ids(lmp: Liggghts) -> NDArray[np.int64]:
+def atom_ids(lmp: Liggghts) -> NDArray[np.int64]:
     """This rank's particle ids (LIGGGHTS 3.8 ``tagint`` is a 32-bit int)."""
     n = lmp.nlocal
     if n == 0:
@@ -165,7 +165,7 @@ class CrossingTracker:
         """Take the particles at ``time_s``; return the crossings since the last update (rank 0;
         None on the other ranks and at the first update of an attempt). Every rank must call
         it at every update."""
-        ids = _atom_ids(lmp)
+        ids = atom_ids(lmp)
         x = lmp.atom_array("x")
         # One reduction: every rank adds its particles' positions, a presence flag and the
         # contact count (-1: the deck has no contact compute) into id-indexed arrays

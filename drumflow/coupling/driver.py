@@ -60,6 +60,7 @@ from drumflow.coupling.interior import (
 )
 from drumflow.coupling.library import Liggghts, loaded_library_path
 from drumflow.coupling.mpi import allreduce_sum
+from drumflow.coupling.outlet import OutletLoop
 from drumflow.coupling.spec import (
     LIBRARY_RECORD,
     OVERLAP_OFF,
@@ -131,6 +132,13 @@ def _rank() -> int:
         if var in os.environ:
             return int(os.environ[var])
     return 0
+
+
+def _size() -> int:
+    for var in ("OMPI_COMM_WORLD_SIZE", "PMI_SIZE"):
+        if var in os.environ:
+            return int(os.environ[var])
+    return 1
 
 
 def _finalize_mpi() -> None:
@@ -312,6 +320,9 @@ def run(spec_path: Path) -> int:
     interior = (InteriorLoop(InteriorSpec.from_json(spec["interior"]),
                              Path(INTERIOR_LOG_PATTERN.format(rank=rank, start=start)))
                 if spec.get("interior") else None)
+    # An open scene (spec key ``outlet``): particles below the outlet level are recorded and
+    # removed at every update (drumflow.coupling.outlet); a closed drum has none.
+    outlet = OutletLoop(spec["outlet"], rank, _size(), start) if spec.get("outlet") else None
     stopped = False
     # A restart pattern lets an interrupt end the loop with a restart at the current step
     # (module docstring); without one (studies, verification scenes) the loop never looks.
@@ -323,6 +334,8 @@ def run(spec_path: Path) -> int:
         out.write(",".join(LOG_COLUMNS) + "\n")
         while step < total:
             started = time.perf_counter()
+            # Before the arrays are read: a deletion reorders them.
+            removed = outlet.take(lmp, clock(step)) if outlet is not None else False
             n = min(interval, total - step)
             if align > 0:
                 n = min(n, align - step % align)
@@ -410,7 +423,8 @@ def run(spec_path: Path) -> int:
                     lmp.command(OVERLAP_ON if wanted else OVERLAP_OFF)
                     overlap_on = wanted
             ran = time.perf_counter()
-            lmp.command(f"run {n} pre no post {post}")
+            # `pre yes` after a deletion: LIGGGHTS must rebuild what refers to the atoms.
+            lmp.command(f"run {n} pre {'yes' if removed else 'no'} post {post}")
             out.write(f",{time.perf_counter() - ran:.6g}\n")
             out.flush()
             step += n
@@ -418,6 +432,11 @@ def run(spec_path: Path) -> int:
         interior.close()
     if warming is not None:
         warming.close()
+    if outlet is not None:
+        if not checkpointed:
+            # The particles that fell below the level in the last interval.
+            outlet.take(lmp, clock(step))
+        outlet.close()
     if checkpointed:
         # Not finished: no closing commands (final snapshot, end restart), no stop verdict.
         if tracker is not None:

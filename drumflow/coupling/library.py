@@ -110,11 +110,11 @@ class Liggghts:
         """A per-atom vector property of a fix (``property/atom ... vector``) as an
         (nlocal, columns) view; LIGGGHTS keeps each atom's values contiguous."""
         ptr = self._lib.lammps_extract_fix(self._handle, fix_id.encode(), 1, 2, 0, 0)
-        if not ptr:
-            raise KeyError(f"LIGGGHTS has no per-atom array {fix_id!r}")
         n = self.nlocal
         if n == 0:
             return np.empty((0, columns))
+        if not ptr:
+            raise KeyError(f"LIGGGHTS has no per-atom array {fix_id!r}")
         rows = C.cast(ptr, C.POINTER(C.POINTER(C.c_double)))
         return np.ctypeslib.as_array(rows[0], shape=(n, columns))
 
@@ -124,11 +124,13 @@ class Liggghts:
         return self._view(ptr, compute_id)
 
     def _view(self, ptr: int | None, name: str) -> NDArray[np.float64]:
-        if not ptr:
-            raise KeyError(f"LIGGGHTS has no per-atom quantity {name!r}")
         n = self.nlocal
         if n == 0:
+            # A rank without particles (an open scene before its first feed) may hold no
+            # array at all; a wrong name is still refused once it has particles.
             return np.empty(0)
+        if not ptr:
+            raise KeyError(f"LIGGGHTS has no per-atom quantity {name!r}")
         return np.ctypeslib.as_array(C.cast(ptr, C.POINTER(C.c_double)), shape=(n,))
 
     def close(self) -> None:

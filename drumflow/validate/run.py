@@ -14,7 +14,9 @@ import numpy as np
 
 from drumflow._mpl import pyplot
 from drumflow.rundir import write_json_atomic
+from drumflow.validate.curtain_output import bookkeeping_closes, plot_curtain, write_curtain_csv
 from drumflow.validate.errors import ValidationDataError
+from drumflow.validate.particle_curtain import run_particle_curtain
 from drumflow.validate.rolling_drum import (
     RPM,
     SURFACE_ANGLE_DEG,
@@ -93,33 +95,15 @@ def run_validation(name: str, out: Path, scale: str | None = None, timeout: floa
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
-    result = run_rolling_drum(out / "runs", scale, timeout=timeout, progress=progress)
     stem = f"{name}_{scale}"
     csv, png = out / f"{stem}.csv", out / f"{stem}.png"
-    write_profile_csv(csv, result)
-    case = result.case
-    plot_profile(png, result, f"{name} ({scale}): {case.particle_count:,} beads, "
-                 f"{case.drum.length:g} m, ends {case.drum.ends}, "
-                 f"t = {result.window_s[0]:.2f}-{result.window_s[1]:.2f} s")
-    record = {
-        "scene": name,
-        "scale": scale,
-        "title": sc.title,
-        "source": sc.source,
-        "measures": list(sc.measures),
-        "setup": [asdict(c) for c in sc.setup],
-        "case": {"name": case.name, "hash": case.hash(), "particles": case.particle_count,
-                 "length_m": case.drum.length, "ends": case.drum.ends},
-        "run_dir": str(result.run_dir),
-        "averaging_window_s": list(result.window_s),
-        "snapshots_averaged": result.snapshots_averaged,
-        "comparison": result.comparison,
-        "all_within_band": all(m["within_band"] for m in result.comparison.values()),
-        "surface_angle_deg": {"simulated": result.surface_angle_deg, "paper": SURFACE_ANGLE_DEG},
-        "csv": csv.name,
-        "plot": png.name,
-        "wall_time_s": time.perf_counter() - t0,
-    }
+    if name == "particle_curtain":
+        body = _particle_curtain(out, scale, csv, png, timeout, progress)
+    else:
+        body = _rolling_drum(out, name, scale, csv, png, timeout, progress)
+    record = {"scene": name, "scale": scale, "title": sc.title, "source": sc.source,
+              "measures": list(sc.measures), "setup": [asdict(c) for c in sc.setup], **body,
+              "csv": csv.name, "plot": png.name, "wall_time_s": time.perf_counter() - t0}
     record = _finite(record)
     path = out / VALIDATION_JSON
     scenes: dict[str, Any] = {}
@@ -130,11 +114,42 @@ def run_validation(name: str, out: Path, scale: str | None = None, timeout: floa
             scenes = {}  # a file of another shape is replaced, not merged
     scenes[stem] = record
     data: dict[str, Any] = {"scenes": scenes}
-    consistency = section_against_full(scenes, name)
+    consistency = section_against_full(scenes, "rolling_drum")
     if consistency is not None:
         data["section_against_full"] = consistency
     write_json_atomic(path, data)
     return record
+
+
+def _rolling_drum(out: Path, name: str, scale: str, csv: Path, png: Path, timeout: float | None,
+                  progress: ProgressCallback | None) -> dict[str, Any]:
+    """The rolling drum's run, CSV, plot and record entries."""
+    result = run_rolling_drum(out / "runs", scale, timeout=timeout, progress=progress)
+    write_profile_csv(csv, result)
+    case = result.case
+    plot_profile(png, result, f"{name} ({scale}): {case.particle_count:,} beads, "
+                 f"{case.drum.length:g} m, ends {case.drum.ends}, "
+                 f"t = {result.window_s[0]:.2f}-{result.window_s[1]:.2f} s")
+    return {
+        "case": {"name": case.name, "hash": case.hash(), "particles": case.particle_count,
+                 "length_m": case.drum.length, "ends": case.drum.ends},
+        "run_dir": str(result.run_dir),
+        "averaging_window_s": list(result.window_s),
+        "snapshots_averaged": result.snapshots_averaged,
+        "comparison": result.comparison,
+        "all_within_band": all(m["within_band"] for m in result.comparison.values()),
+        "surface_angle_deg": {"simulated": result.surface_angle_deg, "paper": SURFACE_ANGLE_DEG},
+    }
+
+
+def _particle_curtain(out: Path, scale: str, csv: Path, png: Path, timeout: float | None,
+                      progress: ProgressCallback | None) -> dict[str, Any]:
+    """The curtain's runs, CSV, plot and record entries."""
+    records = run_particle_curtain(out / "runs", scale, timeout=timeout, progress=progress)
+    write_curtain_csv(csv, records)
+    plot_curtain(png, records, scale)
+    return {"experiments": records,
+            "bookkeeping_closes": all(bookkeeping_closes(r["dem"]["bookkeeping"]) for r in records)}
 
 
 def section_against_full(scenes: dict[str, Any], name: str) -> dict[str, Any] | None:

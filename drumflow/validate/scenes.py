@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from drumflow.validate import rolling_drum
+from drumflow.validate import particle_curtain, rolling_drum
 from drumflow.validate.errors import ValidationDataError
 from drumflow.validate.rolling_drum import SetupChoice
 
@@ -57,8 +57,23 @@ ROLLING_DRUM = Scene(
     scales=rolling_drum.SCALES,
 )
 
+PARTICLE_CURTAIN = Scene(
+    name="particle_curtain",
+    title="sand curtain (204 um) falling 0.6 m through warm air crossing a duct at 0.9-1.2 m/s: "
+          "the six experiments of Figures 3-8, CFD-DEM beside the reduced-order curtain model",
+    source="F. Wardjiman, M. Rhodes, Powder Technology 191 (2009), Figures 3-8 and Section 2 "
+           "(../shared/reference/wardjiman-rhodes-2009-curtain.md; its measured points and "
+           "Table 3 are not in drumflow's copy)",
+    measures=("heat duty, solids and gas sides (W)",
+              "solids outlet temperature (mixed, at the duct floor)",
+              "gas outlet temperature (mixed, downstream of the curtain)",
+              "the curtain's speed and drift at the duct floor; temperature and speed over the height"),
+    setup=particle_curtain.SETUP,
+    scales=particle_curtain.SCALES,
+)
+
 #: Every scene, by name.
-SCENES: dict[str, Scene] = {s.name: s for s in (ROLLING_DRUM,)}
+SCENES: dict[str, Scene] = {s.name: s for s in (ROLLING_DRUM, PARTICLE_CURTAIN)}
 
 
 def scene(name: str) -> Scene:

@@ -47,7 +47,7 @@ def test_registry_names_source_measures_and_setup() -> None:
 
 
 def test_unknown_scene_is_refused_naming_the_allowed() -> None:
-    with pytest.raises(ValidationDataError, match="'nope'.*allowed: rolling_drum"):
+    with pytest.raises(ValidationDataError, match="'nope'.*allowed: particle_curtain, rolling_drum"):
         scene("nope")
 
 
