@@ -37,6 +37,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import pandas as pd
 
+from drumflow.coupling.outlet import read_outlet_log
 from drumflow.validate.errors import ValidationDataError
 from drumflow.validate.rolling_drum import SetupChoice
 
@@ -292,12 +293,12 @@ def run_scene(scene: CurtainScene, work: Path, runner: Runner, timeout: float | 
     return wall
 
 
-def _one(work: Path, pattern: str) -> pd.DataFrame:
+def _one(work: Path, pattern: str) -> Path:
     files = sorted(work.glob(pattern))
     if len(files) != 1:
         raise ValidationDataError(f"{work}: expected one {pattern}, found {len(files)} (a run "
                                   "that was interrupted and resumed is not read here)")
-    return pd.read_csv(files[0])
+    return files[0]
 
 
 def _snapshots(work: Path, scene: CurtainScene) -> pd.DataFrame:
@@ -319,9 +320,10 @@ def summarise_run(work: Path, scene: CurtainScene, bins: int = 12) -> dict[str, 
     enthalpy gain = the heat the loop gave them)."""
     s, geo = scene.case.solids, scene.case.geometry
     cp, t_in = s.heat_capacity, s.inlet_temperature_C
-    outlet = _one(work, "coupling/outlet.*.csv")
-    heat = _one(work, "coupling/rank0.*.csv")
-    air = _one(work, "coupling/air.*.csv")
+    # The outlet log through its reader, which refuses a file without the log's columns.
+    outlet = read_outlet_log(_one(work, "coupling/outlet.*.csv"))
+    heat = pd.read_csv(_one(work, "coupling/rank0.*.csv"))
+    air = pd.read_csv(_one(work, "coupling/air.*.csv"))
     last = outlet.iloc[-1]
     out_n = float(outlet["out"].sum())
     given = float((heat["heat_to_particles_W"] * heat["steps"]).sum() * scene.time_step)
