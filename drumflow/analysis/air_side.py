@@ -148,6 +148,23 @@ def sample_air_side(case: Case, field: _Sampler, columns: dict[str, NDArray[np.f
     )
 
 
+def lumped_h(case: Case, temperature_C: float, time_s: float) -> float:
+    """The constant h, W/(m2 K), at which the case's lumped particles reach ``temperature_C`` at
+    ``time_s`` from its initial temperature: :func:`lumped_mean_temperature` solved for h,
+    ``h = rho cp D / (6 t) ln((T0 - T_air) / (T - T_air))``.
+
+    How a published mean temperature becomes the h the lumped slice would need (the paper's
+    Tables 3-4 per mesh). NaN when ``temperature_C`` is not between the air's and the initial
+    temperature.
+    """
+    p = case.particles
+    t_air = case.air.inlet_temperature_C
+    ratio = (p.initial_temperature_C - t_air) / (temperature_C - t_air)
+    if not (time_s > 0.0 and ratio >= 1.0 and math.isfinite(ratio)):
+        return math.nan
+    return p.density * p.heat_capacity * p.diameter / (6.0 * time_s) * math.log(ratio)
+
+
 def lumped_mean_temperature(case: Case, h_w_m2k: Callable[[float], float] | float,
                             times: NDArray[np.float64], start_C: float | None = None,
                             start_time: float = 0.0) -> NDArray[np.float64]:

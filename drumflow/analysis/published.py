@@ -17,6 +17,7 @@ import numpy as np
 import pandas as pd
 from numpy.typing import ArrayLike, NDArray
 
+from drumflow.analysis.air_side import lumped_h
 from drumflow.case import Case
 from drumflow.physics.validation import AnalysisInputError
 
@@ -105,6 +106,20 @@ class ComparisonRow:
 
     def to_dict(self) -> dict[str, Any]:
         return {**asdict(self), "difference": self.difference, "relative": self.relative}
+
+
+def mesh_h(model: Model, case: Case) -> dict[str, float]:
+    """The paper's h on each of its meshes, W/(m2 K): its mean temperature at 3.5 s (Tables 3-4,
+    meshes 1-3) through the lumped solution of ``case`` (the paper model's case file).
+
+    The paper's own h is far from mesh-converged (model one 79 -> 62 -> 55, model two
+    79 -> 39 -> 24): the spread any comparison with its Tables 3-6 sits in.
+    """
+    paper = PAPER_MODELS[model]
+    temperatures = {"mesh 1": paper.mean_temperature_3p5s_mesh1_C,
+                    "mesh 2": paper.mean_temperature_3p5s_C,
+                    "mesh 3": paper.mean_temperature_3p5s_mesh3_C}
+    return {mesh: lumped_h(case, t, 3.5) for mesh, t in temperatures.items()}
 
 
 def temperature_at(times: NDArray[np.float64], temperatures: NDArray[np.float64], t: float) -> float:

@@ -209,8 +209,11 @@ def test_interrupted_run_resumes(tmp_path: Path) -> None:
     dumps = out / "dem" / "dumps"
     assert not list(dumps.glob("snap.*.txt")) and len(list(dumps.glob("snap.*.npz"))) == len(snaps.steps)
     # The machine's load beside the DEM log, both attempts in it: the run's ranks took CPU.
+    # Not in every row: while Open MPI starts the ranks the session can sit near idle (a CI
+    # machine logged 0.18 cores for the first two rows), so the busiest row carries the check.
     load = read_load_log(out / "dem" / LOAD_LOG)
-    assert len(load) >= 2 and (load["run_cores"] > 0.2).all(), load
+    assert len(load) >= 2 and load["run_cores"].max() > 0.5, load
+    assert (load["run_cores"] >= 0).all() and (load["other_cores"] >= 0).all(), load
 
 
 @pytest.mark.timeout(300)

@@ -7,6 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+import drumflow.air.heat as air_heat
 from drumflow.air.field import AirField
 from drumflow.air.heat import AirHeat, coarse_field
 
@@ -59,9 +60,34 @@ def test_implicit_particles_give_the_same_field_as_their_heat_as_a_source() -> N
     source = np.zeros(heat.cells)
     np.add.at(source, cells, 0.5 * (90.0 - implicit[cells]))
     np.testing.assert_allclose(heat.solve(source), implicit, atol=1e-8)
+    # That solve starts from the implicit one's field, which already solves it to the tolerance:
+    # at most one iteration (regression: every update solved both from the inlet temperature,
+    # with the particles' curtain 61 % of the curtain scene's wall time).
+    assert heat.iterations <= 1
+    # A cold start gives the same field to the tolerance.
+    cold = AirHeat(_duct(), 30.0, RHO, CP)
+    np.testing.assert_allclose(cold.solve(source), implicit, atol=1e-8)
+    assert cold.iterations > 1
     # A particle never heats its air past itself, however strong its film.
     strong = heat.solve_with_particles(g * 1e4, gt * 1e4)
     assert strong.max() <= 90.0 + 1e-6
+
+
+def test_the_incomplete_lu_takes_over_when_the_lines_fail(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A cross-flow the lines along the axis leave out (random velocities, an obstacle) and a
+    strong particle conductance: the lines converge in a few iterations; given one only, they
+    fail, the incomplete LU gives the same field, and it stays in use."""
+    field = _duct(noise=0.5, blocked=True)
+    g = np.random.default_rng(3).uniform(0.0, 5.0, AirHeat(field, 30.0, RHO, CP).cells)
+    lines = AirHeat(field, 30.0, RHO, CP)
+    expected = lines.solve_with_particles(g, 90.0 * g)
+    assert lines.preconditioner == "lines" and 0 < lines.iterations < 30
+    monkeypatch.setattr(air_heat, "LINE_ITERATIONS", 1)
+    fallback = AirHeat(field, 30.0, RHO, CP)
+    np.testing.assert_allclose(fallback.solve_with_particles(g, 90.0 * g), expected, atol=1e-8)
+    assert fallback.preconditioner == "incomplete LU"
+    np.testing.assert_allclose(fallback.solve(np.zeros(fallback.cells)), 30.0, atol=1e-8)
+    assert fallback.preconditioner == "incomplete LU"
 
 
 def test_points_in_walls_go_to_the_nearest_fluid_cell() -> None:

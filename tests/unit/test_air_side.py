@@ -11,6 +11,7 @@ import pytest
 from drumflow.air.field import AirField
 from drumflow.analysis.air_side import (
     airborne_mask,
+    lumped_h,
     lumped_mean_temperature,
     sample_air_side,
 )
@@ -72,3 +73,31 @@ def test_lumped_prediction_constant_and_time_varying(case) -> None:  # type: ign
     varying = lumped_mean_temperature(case, lambda t: 40.0 + 10.0 * t, fine)
     exact_v = 30.0 + 60.0 * np.exp(-rate * (40.0 * fine + 5.0 * fine**2))
     assert varying == pytest.approx(exact_v, rel=1e-6)
+
+
+def test_lumped_h_inverts_the_lumped_solution(case) -> None:  # type: ignore[no-untyped-def]
+    """h back from the temperature the lumped solution gives with it; outside the air's and the
+    start's temperatures there is no h."""
+    for h in (5.0, 47.4, 300.0):
+        temperature = float(lumped_mean_temperature(case, h, np.array([3.5]))[0])
+        assert lumped_h(case, temperature, 3.5) == pytest.approx(h, rel=1e-12)
+    t_air, t0 = case.air.inlet_temperature_C, case.particles.initial_temperature_C
+    assert math.isnan(lumped_h(case, t_air - 1.0, 3.5))
+    assert math.isnan(lumped_h(case, t0 + 1.0, 3.5))
+    assert lumped_h(case, t0, 3.5) == 0.0
+
+
+def test_the_papers_h_over_its_meshes() -> None:
+    """Tables 3-4's T(3.5 s) per mesh through the lumped solution of the paper cases, against
+    values computed by hand: h = rho cp D / (6 t) ln(60 / (T - 30)) with rho cp = 1050 x 1465.38
+    J/(m3 K), D = 8 and 20 mm (model one mesh 1: 2051.53 / 3.5 x ln(60 / 52.42) = 79.16)."""
+    from pathlib import Path
+
+    from drumflow.analysis.published import mesh_h
+    from drumflow.case import load_case
+
+    cases = Path(__file__).resolve().parents[2] / "cases"
+    one = mesh_h("one", load_case(cases / "paper_model_one.toml"))
+    two = mesh_h("two", load_case(cases / "paper_model_two.toml"))
+    assert [round(one[m], 1) for m in ("mesh 1", "mesh 2", "mesh 3")] == [79.2, 62.0, 54.6]
+    assert [round(two[m], 1) for m in ("mesh 1", "mesh 2", "mesh 3")] == [79.0, 39.4, 23.6]

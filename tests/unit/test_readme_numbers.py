@@ -112,3 +112,20 @@ def test_the_fast_profile_ratio() -> None:
     reference = max(wall.values())  # the conservative reference is the slowest row
     fast = min(wall.values())
     assert f"{reference / fast:.2f} times the conservative" in README
+
+
+def test_the_papers_mesh_spread() -> None:
+    """'needs h of 79 -> 62 -> 55 ... on model one and 79 -> 39 -> 24 on model two' and '0.22 K
+    from its mesh-1 value (82.42)': the paper's tables through the paper cases' lumped solution."""
+    from drumflow.analysis.published import PAPER_MODELS, mesh_h
+    from drumflow.case import load_case
+
+    flat = " ".join(README.split())
+    for model, name in (("one", "model one"), ("two", "model two")):
+        h = mesh_h(model, load_case(ROOT / "cases" / f"paper_model_{model}.toml"))  # type: ignore[arg-type]
+        chain = " → ".join(f"{h[m]:.0f}" for m in ("mesh 1", "mesh 2", "mesh 3"))
+        assert f"{chain} W/(m² K) on {name}" in flat or f"{chain} on {name}" in flat, (chain, name)
+    ours = float(numbers.value("results/paper/model_one/post/mean_temperature.csv", "mean_temperature_C",
+                               ".2f", row={"time_s": 3.50042208}))
+    mesh1 = PAPER_MODELS["one"].mean_temperature_3p5s_mesh1_C
+    assert f"{ours - mesh1:.2f} K from its mesh-1 value ({mesh1:.2f})" in flat

@@ -1,0 +1,152 @@
+"""Benchmark: one air update of air that warms (drumflow.air.heat), as it was and as it is.
+
+One update of the coupling loop solves the air's temperature twice: with the particles'
+conductance implicit (what the particles see), then with the heat they gave as a source (the
+bookkeeping). Until 2026-11-29 both solves were BiCGSTAB preconditioned by an incomplete LU of
+the transport alone, each from the inlet temperature ("before"); now the preconditioner is the
+grid's lines along the air's flow with the particles' conductance in them, each solve starting
+from the last one's field ("now"). Both arms are run here on the same systems, interleaved
+A-B-A-B (three rounds of a sequence of updates each), on:
+
+* the curtain scene's duct (Figure 4, parcels of 4 grains: ``duct_air``), with 22,000 parcels
+  spread over the curtain (the slit's thickness widening downstream to 0.33 m at the floor, as
+  the CFD-DEM run measured) falling 0.29 mm per update (1.5 m/s over 19 steps of 1e-5 s);
+* optionally a drum's air field (``--field PATH`` of a run's ``air/field.npz``, at ``--spacing``
+  m: the grid the loop would solve on) with a bed in its lower part (particles in the cells
+  below 0.4 of the radius, conductance one to ten times the cells' own air capacity flow).
+
+The particles are synthetic (placed, not simulated): the systems have the real grids and flows
+and the parcels' film conductances, which is what the solver's cost depends on. Writes OUT.json
+(per arm and grid: median and range of the wall time per update, iterations per solve, the
+largest difference between the arms' fields) and prints it.
+
+Usage: .venv/bin/python studies/bench_air_heat.py OUT.json [--field PATH --spacing M]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import platform
+import statistics
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from drumflow.air.field import AirField
+from drumflow.air.heat import AirHeat, coarse_field
+from drumflow.physics.particle_air import AirState, ranz_marshall_h
+from drumflow.rundir import cpu_model
+from drumflow.validate.particle_curtain import curtain_scene, duct_air, load_experiment
+
+UPDATES = 20  # updates per round and arm
+ROUNDS = 3
+
+
+Grid = tuple[AirField, float, np.ndarray, np.ndarray, np.ndarray, np.ndarray]
+
+
+def _curtain(rng: np.random.Generator) -> Grid:
+    case = load_experiment("curtain_fig4")
+    scene = curtain_scene(case, 4.0)
+    field = duct_air(scene)
+    geo = case.geometry
+    n = 22_000
+    height = rng.uniform(0.0, geo.height, n)
+    depth = 1.0 - height / geo.height  # 0 at the slit, 1 at the floor
+    half = 0.5 * geo.thickness
+    z = rng.uniform(-half, half, n) - 0.33 * depth * rng.uniform(0.0, 1.0, n)
+    x = np.column_stack([rng.uniform(0.0, geo.width, n), height, z])
+    air = AirState.at(case.gas.inlet_temperature_C, case.gas.pressure_kPa)
+    d = scene.parcel_diameter / scene.coarse_grain
+    g = ranz_marshall_h(np.full(n, 1.5), np.full(n, d), air) * np.pi * d**2 * scene.coarse_grain**3
+    temperature = rng.uniform(case.gas.inlet_temperature_C, case.solids.inlet_temperature_C, n)
+    step = np.array([0.0, -1.5 * 19 * 1e-5, 0.0])
+    return field, case.gas.inlet_temperature_C, x, g, temperature, step
+
+
+def _drum(path: Path, spacing: float, rng: np.random.Generator) -> Grid:
+    field = coarse_field(AirField.from_npz(path), spacing)
+    probe = AirHeat(field, 30.0, 1.16, 1007.0)
+    nodes = probe.nodes_xyz()
+    radius = float(np.abs(nodes[:, :2]).max())
+    bed = nodes[nodes[:, 1] < -0.4 * radius]
+    per_cell = 20
+    x = np.repeat(bed, per_cell, axis=0) + rng.uniform(-0.5, 0.5, (len(bed) * per_cell, 3)) * field.spacing
+    capacity = 1.16 * 1007.0 * 3.0 * float(field.spacing[0] * field.spacing[1])
+    g = rng.uniform(1.0, 10.0, len(x)) * capacity / per_cell
+    temperature = rng.uniform(60.0, 90.0, len(x))
+    return field, 30.0, x, g, temperature, np.array([0.0, 0.0, 0.0])
+
+
+def _updates(heat: AirHeat, x: np.ndarray, g: np.ndarray, temperature: np.ndarray,
+             step: np.ndarray, before: bool) -> tuple[list[float], list[int], np.ndarray]:
+    """UPDATES updates as the loop makes them; the wall time of each and its iterations."""
+    if before:
+        heat.preconditioner = "incomplete LU"
+    walls, iterations = [], []
+    field = np.zeros(heat.cells)
+    for k in range(UPDATES):
+        points = x + k * step
+        t0 = time.perf_counter()
+        if before:
+            heat._last = None  # the old code started every solve from the inlet temperature
+        cells = heat.cells_of(points)
+        conductance = heat.deposit(cells, g)
+        field = heat.solve_with_particles(conductance, heat.deposit(cells, g * temperature))
+        first = heat.iterations
+        if before:
+            heat._last = None
+        heat.solve(heat.deposit(cells, g * (temperature - field[cells])))
+        walls.append(time.perf_counter() - t0)
+        iterations.append(first + heat.iterations)
+    return walls, iterations, field
+
+
+def bench(name: str, grid: Grid) -> dict[str, Any]:
+    field, inlet, x, g, temperature, step = grid
+    arms: dict[str, dict[str, list[float]]] = {"before": {"wall": [], "iterations": []},
+                                               "now": {"wall": [], "iterations": []}}
+    fields: dict[str, np.ndarray] = {}
+    for _ in range(ROUNDS):
+        for arm in ("before", "now"):
+            heat = AirHeat(field, inlet, 1.16, 1007.0)
+            walls, iterations, fields[arm] = _updates(heat, x, g, temperature, step, arm == "before")
+            arms[arm]["wall"] += walls
+            arms[arm]["iterations"] += iterations
+    out: dict[str, Any] = {"grid": name, "cells": int(AirHeat(field, inlet, 1.16, 1007.0).cells),
+                           "particles": len(x), "updates_per_round": UPDATES, "rounds": ROUNDS}
+    for arm, data in arms.items():
+        out[arm] = {"median_update_s": statistics.median(data["wall"]),
+                    "min_update_s": min(data["wall"]), "max_update_s": max(data["wall"]),
+                    "median_iterations_per_update": statistics.median(data["iterations"])}
+    out["speedup_median"] = out["before"]["median_update_s"] / out["now"]["median_update_s"]
+    out["largest_field_difference_K"] = float(np.abs(fields["before"] - fields["now"]).max())
+    return out
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("out", type=Path)
+    parser.add_argument("--field", type=Path)
+    parser.add_argument("--spacing", type=float, default=0.053)
+    args = parser.parse_args()
+    rng = np.random.default_rng(7)
+    results = [bench("curtain_fig4 duct, parcels of 4 grains", _curtain(rng))]
+    if args.field is not None:
+        drum = _drum(args.field, args.spacing, rng)
+        results.append(bench(f"drum field {args.field} at {args.spacing} m", drum))
+    record = {"what": "one air update of air that warms (two solves), before and now, interleaved",
+              "machine": {"cpu": cpu_model(), "platform": platform.platform()},
+              "note": "idle machine required: the arms are interleaved, but a busy core moves both",
+              "results": results}
+    args.out.parent.mkdir(parents=True, exist_ok=True)
+    args.out.write_text(json.dumps(record, indent=1) + "\n")
+    print(json.dumps(record, indent=1))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
