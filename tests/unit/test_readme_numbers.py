@@ -28,6 +28,7 @@ PLANT = "docs/plant/paper_model_one_plant.json"
 SPIN = "results/bench/paper_model_two_spin/ladder.csv"
 CG_LADDER = "results/bench/paper_model_two_ladder/ladder.csv"
 MEASURED = "results/bench/paper_model_two_ladder_measured/ladder.csv"
+PERIODIC = "docs/plant/paper_model_one_plant_periodic.json"
 
 #: (text typed in the README with its number in brackets, file, key, format). The text without
 #: the brackets is searched as it stands in a sentence; the value read from the file, formatted,
@@ -58,6 +59,18 @@ TYPED: list[tuple[str, str, str, str]] = [
     ("flow by [5.4] %", SPIN, "default_step.error_steady_mass_flow", ".1%"),
     ("heat answer to\n  [0.35] %", CG_LADDER, "parcels.error_h", ".2%"),
     ("flow by [7.5] %", CG_LADDER, "parcels.error_steady_mass_flow", ".1%"),
+    ("| measured (the paper's Table 1) | [46.5] |", PLANT, "measured.material_outlet_C", ".1f"),
+    ("| measured (the paper's Table 1) | 46.5 | [59.0] |", PLANT, "measured.air_outlet_C", ".1f"),
+    ("A 1,099 m²) | [40.92] |", PLANT, "paper_exchanger.material_outlet_C", ".2f"),
+    ("A 1,099 m²) | 40.92 | [69.76] |", PLANT, "paper_exchanger.air_outlet_C", ".2f"),
+    ("every falling granule | [30.62] |", PLANT, "material_outlet_temperature_C", ".2f"),
+    ("every falling granule | 30.62 | [78.10] |", PLANT, "air_outlet_temperature_C", ".2f"),
+    ("falling flow [109.5] kg/(s m)", PLANT, "plant_closures.falling_mass_flow_kg_s_m", ".1f"),
+    ("fall height [1.21] m", PLANT, "plant_closures.fall_height_m", ".2f"),
+    ("bed surface [2.68] m²/m", PLANT, "plant_closures.bed_surface_m2_per_m", ".2f"),
+    ("from the periodic slice | [37.75] |", PERIODIC, "material_outlet_temperature_C", ".2f"),
+    ("from the periodic slice | 37.75 | [72.32] |", PERIODIC, "air_outlet_temperature_C", ".2f"),
+    ("and [3.71] m³/s per m through", PERIODIC, "curtain_air.setting_m3_s_per_m", ".2f"),
     ("cascading flow is\n  [5.8] % high", MEASURED, "old_defaults.error_steady_mass_flow", ".1%"),
     ("the reference at\n  [14.0] s within", MEASURED, "reference_rule.stop_time_s", ".1f"),
     ("within [0.08] % of its end", MEASURED, "reference_rule.error_steady_mass_flow", ".2%"),
