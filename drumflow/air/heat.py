@@ -21,11 +21,13 @@ OpenFOAM solution resampled, or plug flow), with the air's own flow, at every ai
   solved by BiCGSTAB preconditioned by its lines along the drum's axis: the tridiagonal part of
   the matrix in the cells' own order, which holds the advection along the axis (the air's main
   flow) and the particles' conductance exactly, leaving the cross-flow and conduction to the
-  iteration. Measured (a shared 2-core machine, so the times are rough): on the curtain
-  scene's grid with its parcels, 6 iterations in 50-80 ms against 11-12 in 0.28-0.54 s for an
-  incomplete LU of the transport, which leaves the particles out; on model two's 0.053 m grid
-  with a synthetic bed, 12-15 iterations against 7-38, 0.19-0.29 s against 0.6-3.1 s. Should
-  the lines not converge, the incomplete LU takes over for the rest of the run.
+  iteration. Measured side by side (``studies/bench_air_heat.py``,
+  ``results/bench/air_heat/results.json``: one update, both solves, median of 60): on the
+  curtain scene's duct with 22,000 parcels 0.018 s against 0.113 s for the incomplete LU of the
+  transport from the inlet temperature (which leaves the particles out of the preconditioner),
+  on model two's 0.053 m grid (50,800 cells) with a moving bed 0.078 s against 2.58 s (11
+  iterations against 79). Should the lines not converge, the incomplete LU takes over for the
+  rest of the run.
   Each solve starts from the last one's field: the bookkeeping's solve (the heat the particles
   actually gave, as a source) follows the implicit one on the same system when the particles
   are lumped, so it starts converged.
@@ -60,8 +62,8 @@ from drumflow.air.field import AirField
 __all__ = ["AIR_CONDUCTIVITY", "AirHeat", "coarse_field"]
 
 #: BiCGSTAB iterations the lines' preconditioner is given before the incomplete LU takes over
-#: (they took 6-15 on the curtain's and model two's grids, each about a fifth of the cost of one
-#: of the incomplete LU's).
+#: (an update took 5 on the curtain's grid and 11 on model two's, where the incomplete LU took
+#: 79: results/bench/air_heat).
 LINE_ITERATIONS = 100
 
 #: Molecular conductivity of air near 30 C, W/(m K) (Incropera Table A.4 at 300 K: 0.0263): it
