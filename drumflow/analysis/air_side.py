@@ -159,8 +159,11 @@ def lumped_h(case: Case, temperature_C: float, time_s: float) -> float:
     """
     p = case.particles
     t_air = case.air.inlet_temperature_C
-    ratio = (p.initial_temperature_C - t_air) / (temperature_C - t_air)
-    if not (time_s > 0.0 and ratio >= 1.0 and math.isfinite(ratio)):
+    excess = temperature_C - t_air
+    if not (time_s > 0.0 and excess != 0.0):
+        return math.nan  # at the air's temperature only an infinite h gets there
+    ratio = (p.initial_temperature_C - t_air) / excess
+    if not (ratio >= 1.0 and math.isfinite(ratio)):
         return math.nan
     return p.density * p.heat_capacity * p.diameter / (6.0 * time_s) * math.log(ratio)
 

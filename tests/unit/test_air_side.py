@@ -83,6 +83,8 @@ def test_lumped_h_inverts_the_lumped_solution(case) -> None:  # type: ignore[no-
         assert lumped_h(case, temperature, 3.5) == pytest.approx(h, rel=1e-12)
     t_air, t0 = case.air.inlet_temperature_C, case.particles.initial_temperature_C
     assert math.isnan(lumped_h(case, t_air - 1.0, 3.5))
+    assert math.isnan(lumped_h(case, t_air, 3.5))  # regression: divided by zero
+    assert math.isnan(lumped_h(case, 0.5 * (t_air + t0), 0.0))
     assert math.isnan(lumped_h(case, t0 + 1.0, 3.5))
     assert lumped_h(case, t0, 3.5) == 0.0
 
