@@ -78,8 +78,8 @@ def test_the_incomplete_lu_takes_over_when_the_lines_fail(monkeypatch: pytest.Mo
     strong particle conductance: the lines converge in a few iterations; given one only, they
     fail, the incomplete LU gives the same field, and it stays in use."""
     field = _duct(noise=0.5, blocked=True)
-    g = np.random.default_rng(3).uniform(0.0, 5.0, AirHeat(field, 30.0, RHO, CP).cells)
     lines = AirHeat(field, 30.0, RHO, CP)
+    g = np.random.default_rng(3).uniform(0.0, 5.0, lines.cells)
     expected = lines.solve_with_particles(g, 90.0 * g)
     assert lines.preconditioner == "lines" and 0 < lines.iterations < 30
     monkeypatch.setattr(air_heat, "LINE_ITERATIONS", 1)
