@@ -279,12 +279,14 @@ class StartStateError(DrumflowError, ValueError):
     Attributes
     ----------
     field, path, problem
-        The case field (``run.start_state``) and the arguments.
+        The case field (``run.start_state``, or ``air.bed_states[k]``) and the arguments.
     """
 
     field = "run.start_state"
 
-    def __init__(self, path: Path | str, problem: str) -> None:
+    def __init__(self, path: Path | str, problem: str, field: str = "run.start_state") -> None:
+        # The case field: run.start_state, or one of air.bed_states (air around the bed).
+        self.field = field
         self.path = Path(path)
         self.problem = problem
         super().__init__(f"{self.field} = {str(path)!r}: {problem}")

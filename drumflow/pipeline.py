@@ -38,6 +38,7 @@ from drumflow.dem.stage import (
     ProgressCallback,
     clear_stop_request,
     kept_time_step,
+    load_bed_states,
     load_start_state,
     plan_run,
 )
@@ -125,6 +126,7 @@ def run_case(
     # A start state that does not fit the case is refused before any stage runs (geometry and
     # air take minutes at paper scale).
     load_start_state(case)
+    bed_states = tuple(load_bed_states(case))
     runner = Runner(profile)
     rundir = RunDir(out)
     rundir.bind_case(case.canonical_json(), case.hash(), case_to_toml(case), force=force,
@@ -155,7 +157,9 @@ def run_case(
                        "directory for the new step"})
             step_rule = kept_step_rule(moved, kept)
     nprocs = runner.profile.processes_for(moved)
-    coupling = _air(case, rundir, runner, nprocs, plan.time_step, plan.dump_every, progress)
+    coupling = _air(case, rundir, runner, AirInputs(processes=nprocs, progress=progress,
+                                                    bed_states=bed_states),
+                    plan.time_step, plan.dump_every)
     rundir.record("skips", skips(moved, step_rule, coupling is not None, shape.wall_motion, nprocs))
     inputs = DemInputs(shape, choice, plan, processes=nprocs, coupling=coupling, steps=steps,
                        timeout=timeout, progress=progress)
@@ -172,11 +176,11 @@ def run_case(
     return summary
 
 
-def _air(case: Case, rundir: RunDir, runner: Runner, processes: int, time_step: float,
-         dump_every: int, progress: ProgressCallback | None) -> CouplingSpec | None:
+def _air(case: Case, rundir: RunDir, runner: Runner, inputs: AirInputs, time_step: float,
+         dump_every: int) -> CouplingSpec | None:
     """The air stage's field and the coupling spec built from it (``None`` without air)."""
     try:
-        field = air.run(case, rundir, runner, AirInputs(processes=processes, progress=progress))
+        field = air.run(case, rundir, runner, inputs)
     finally:
         # Every OpenFOAM program run (or failed) goes into the manifest with its timing.
         rundir.record_commands([r.as_dict() for r in runner.records])

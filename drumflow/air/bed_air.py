@@ -58,6 +58,7 @@ from drumflow.air.solids_fraction import (
 from drumflow.errors import AnalysisInputError, MeshCheckError
 
 if TYPE_CHECKING:
+    from drumflow.air.foam_results import AirSolution
     from drumflow.case import Case
     from drumflow.runner import Runner
 
@@ -347,10 +348,15 @@ class BedAirResult:
     bed: AirMeasure
     wall_time_s: float
     fields: dict[str, NDArray[np.float64]] = field(repr=False, default_factory=dict)
+    # The two OpenFOAM solutions (their case folders), for a caller that resamples the bed's
+    # field (drumflow.air.bed_phases) or solves another state from the same empty drum.
+    empty_solution: AirSolution | None = field(repr=False, default=None, compare=False)
+    bed_solution: AirSolution | None = field(repr=False, default=None, compare=False)
 
     def as_dict(self) -> dict[str, Any]:
         out = asdict(self)
-        out.pop("fields")
+        for name in ("fields", "empty_solution", "bed_solution"):
+            out.pop(name)
         out["thresholds"] = {"bed_fraction": BED_FRACTION, "curtain_fraction": CURTAIN_FRACTION,
                              "porous_fraction": POROUS_FRACTION}
         return out
@@ -429,6 +435,7 @@ def solve_bed_air(
     timeout: float | None = 7200.0,
     law: ErgunLaw = ERGUN,
     axial: Axial = "periodic",
+    empty: AirSolution | None = None,
 ) -> BedAirResult:
     """Solve the drum's air empty and with ``state``'s particles as porosity; measure both.
 
@@ -448,6 +455,9 @@ def solve_bed_air(
         ``"periodic"`` (default): the slice as a piece of a long drum at the case's mean air
         velocity (:mod:`drumflow.air.periodic`; at least :data:`PERIODIC_MAX_ITERATIONS`
         SIMPLE iterations allowed); ``"inlet-outlet"``: the case's own ends.
+    empty
+        The empty drum's solution of an earlier call with the same case and ``axial`` (its
+        ``empty_solution``): not solved again.
 
     Raises
     ------
@@ -469,8 +479,9 @@ def solve_bed_air(
             update={"max_iterations": PERIODIC_MAX_ITERATIONS})})
     t0 = time.perf_counter()
     workdir = Path(workdir)
-    empty = solve_air(case, workdir / "empty", runner, processes=processes, timeout=timeout,
-                      periodic=periodic)
+    if empty is None:
+        empty = solve_air(case, workdir / "empty", runner, processes=processes, timeout=timeout,
+                          periodic=periodic)
     mesh = read_poly_mesh(empty.case_dir)
     cells = read_cell_fields(empty.case_dir, empty.time_dir)
     deposit = deposit_state(case, state, mesh, cells, spacing)
@@ -519,6 +530,8 @@ def solve_bed_air(
         wall_time_s=time.perf_counter() - t0,
         fields={"C": cells["C"], "fraction": deposit.fraction, "U_empty": cells["U"],
                 "U_bed": bed_cells["U"]},
+        empty_solution=empty,
+        bed_solution=bed,
     )
 
 

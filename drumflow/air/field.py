@@ -61,10 +61,11 @@ def air_cache_key(case: Case) -> str:
     coupling: particles do not act on the air), the run settings, ``drum.facet_size`` and
     ``drum.tilt_deg`` (the DEM wall STL and gravity's direction; the air model has no gravity),
     ``drum.ends`` (the particles' end walls; the air passes the end faces in every case),
-    and of the air section ``coupling_interval``, ``pressure_gradient_force``, ``heat_capacity``
-    and ``warming`` (they act only on the particle side, or on the air's temperature, not its
-    flow; a field option added later must be left out too, or every cached field and every run
-    keyed on one is recomputed). The resampling version :data:`FIELD_FORMAT_VERSION` is part of
+    and of the air section ``coupling_interval``, ``pressure_gradient_force``, ``heat_capacity``,
+    ``warming`` and ``bed_states`` (they act only on the particle side, on the air's
+    temperature, or, the bed states, on fields keyed apart by the air stage; a field option
+    added later must be left out too, or every cached field and every run keyed on one is
+    recomputed). The resampling version :data:`FIELD_FORMAT_VERSION` is part of
     the key.
     """
     data = case.model_dump(mode="json")
@@ -74,7 +75,8 @@ def air_cache_key(case: Case) -> str:
     air = {
         k: v
         for k, v in data["air"].items()
-        if k not in ("coupling_interval", "pressure_gradient_force", "heat_capacity", "warming")
+        if k not in ("coupling_interval", "pressure_gradient_force", "heat_capacity", "warming",
+                     "bed_states")
     }
     key = {
         "version": FIELD_FORMAT_VERSION,

@@ -26,9 +26,10 @@ class FieldSource:
     Attributes
     ----------
     field
-        ``{"kind": "uniform", "velocity": [ux, uy, uz]}`` or
-        ``{"kind": "grid", "path": "/abs/path/field.npz"}`` (see
-        :func:`drumflow.coupling.driver.load_field`).
+        ``{"kind": "uniform", "velocity": [ux, uy, uz]}``,
+        ``{"kind": "grid", "path": "/abs/path/field.npz"}`` or, the air around the bed,
+        ``{"kind": "phases", "paths": [...], "angles": [...], "spacing": ..., "omega": ...}``
+        (see :func:`drumflow.coupling.driver.load_field`).
     key
         Identifies the field (a hash), for the DEM stage key.
     omega

@@ -34,6 +34,7 @@ from drumflow.physics.air import ideal_gas_density
 from drumflow.readers import read_json_object
 
 if TYPE_CHECKING:
+    from drumflow.air.bed_air import BedSnapshot
     from drumflow.case import Case
     from drumflow.rundir import RunDir
     from drumflow.runner import Runner
@@ -80,10 +81,15 @@ class AirInputs:
         MPI ranks for simpleFoam (from the launch profile).
     progress
         ``progress(stage, done, total)``: SIMPLE iterations of the ``"air"`` stage.
+    bed_states
+        The states of ``air.bed_states``, read and checked against the scene by the caller
+        (:func:`drumflow.dem.stage.load_bed_states`): the air around each one's bed is solved
+        (:mod:`drumflow.air.bed_phases`).
     """
 
     processes: int = 1
     progress: Callable[[str, float, float], None] | None = None
+    bed_states: tuple[BedSnapshot, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -110,6 +116,8 @@ def run(case: Case, rundir: RunDir, runner: Runner, inputs: AirInputs) -> AirRes
                            summary)
     else:
         result = _run_cfd(case, rundir, runner, inputs)
+        if case.air.bed_states:
+            result = _with_bed_phases(case, rundir, runner, inputs, result)
     if inputs.progress:
         # One bar per stage, finished when the stage ends (a converged solve stops before
         # air.max_iterations).
@@ -180,3 +188,54 @@ def _run_cfd(case: Case, rundir: RunDir, runner: Runner, inputs: AirInputs) -> A
                if k in ("iterations", "final_residuals", "cells", "wall_time_s")},
     )
     return AirResult(source, summary)
+
+
+#: Version of the bed phases' solve and files; part of their cache key.
+BED_PHASES_VERSION = 1
+
+
+def _with_bed_phases(case: Case, rundir: RunDir, runner: Runner, inputs: AirInputs,
+                     empty: AirResult) -> AirResult:
+    """The air around the bed (``air.bed_states``): each state's air solved once, cached by the
+    empty drum's key and the states' contents, its field beside the empty drum's in the run
+    directory; the coupling loop gets them all (field kind ``phases``)."""
+    import hashlib
+
+    from drumflow.air.bed_phases import PHASES_RECORD, lifter_spacing, solve_bed_phases
+    from drumflow.rundir import hash_text
+
+    if len(inputs.bed_states) != len(case.air.bed_states):
+        raise ValueError(f"air.bed_states names {len(case.air.bed_states)} state(s), the stage "
+                         f"was given {len(inputs.bed_states)} (drumflow.dem.stage.load_bed_states)")
+    contents = [hashlib.sha256(Path(p).read_bytes()).hexdigest() for p in case.air.bed_states]
+    key = hash_text(json.dumps({"air": empty.source.key, "states": contents,
+                                "version": BED_PHASES_VERSION}))
+    cache = air_cache_dir() / f"bed-{key}"
+    hit = (cache / PHASES_RECORD).exists()
+    t0 = time.perf_counter()
+    if not hit:
+        work = rundir.air / "bed_openfoam"
+        if work.exists():
+            shutil.rmtree(work)
+        solve_bed_phases(case, list(inputs.bed_states), work, cache, runner,
+                         processes=inputs.processes)
+    record = read_json_object(cache / PHASES_RECORD,
+                              "the bed phases' cache record (delete its folder to solve again)")
+    paths = []
+    for k in range(len(case.air.bed_states)):
+        paths.append(rundir.air / f"bed_phase_{k}.npz")
+        shutil.copyfile(cache / f"bed_phase_{k}.npz", paths[-1])
+    (rundir.air / PHASES_RECORD).write_text(json.dumps(record, indent=2))
+    angles = [float(s["angle_rad"]) for s in record["states"]]
+    field_spec = {"kind": "phases", "paths": [str(p) for p in paths], "angles": angles,
+                  "spacing": lifter_spacing(case.lifters.count), "omega": case.drum.omega}
+    summary = empty.summary
+    summary.extra["bed_phases"] = {
+        "states": [s["source"] for s in record["states"]],
+        "angles_rad": angles,
+        "time_s": [float(s["time_s"]) for s in record["states"]],
+        "cache_hit": hit,
+        "solve_wall_time_s": float(record["wall_time_s"]),
+        "stage_wall_time_s": time.perf_counter() - t0,
+    }
+    return AirResult(FieldSource(field_spec, f"phases:{key}", case.drum.omega), summary)

@@ -16,8 +16,9 @@ here from the run directory through the same readers ``drumflow post`` uses:
 * **fall height** ``H_f = t_f <v_down>``: the same law for distance (the airborne mass times
   its mean downward speed is the falling flow times the mean drop of one fall);
 * **slip velocity** of the airborne particles against the air field (the run's
-  ``air/field.npz``), the speed that enters Ranz-Marshall; for ``air.model = "uniform"`` the
-  air is the plug flow of the run, for ``"none"`` still air;
+  ``air/field.npz``, or with ``air.bed_states`` the air around the bed), the speed that enters
+  Ranz-Marshall; for ``air.model = "uniform"`` the air is the plug flow of the run, for
+  ``"none"`` still air;
 * **bed exposed surface** per metre (m^2/m): the length of the bed's top profile in the cross
   section (the highest non-airborne particle below the axis in bins two diameters wide, bins
   within one lifter height of the wall dropped as lifter pockets), times one metre of drum.
@@ -30,7 +31,7 @@ from __future__ import annotations
 
 import json
 import math
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass, fields
 from pathlib import Path
 from typing import Any
 
@@ -39,6 +40,7 @@ import pandas as pd
 from numpy.typing import NDArray
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
 
+from drumflow.analysis.air_closures import AirClosures, validate_air_closures
 from drumflow.analysis.air_side import airborne_mask
 from drumflow.analysis.observables import falling_mass_flow
 from drumflow.case import Case, load_case
@@ -93,6 +95,10 @@ class SliceClosures:
     start_s
         The simulated time from which they were measured (``--start``, or the case's
         ``run.mass_flow_start``); None in files written before it was recorded.
+    air
+        What a periodic slice's air around the bed measured (through-curtain air with its
+        mixing bounds, contact efficiencies; :mod:`drumflow.analysis.air_closures`), once
+        attached (``drumflow plant --curtain-air HEAT.json --save-closures``); None before.
     """
 
     source: str
@@ -119,6 +125,7 @@ class SliceClosures:
     snapshots: int
     window_s: tuple[float, float]
     start_s: float | None = None
+    air: AirClosures | None = None
 
     @property
     def froude(self) -> float:
@@ -132,8 +139,9 @@ class SliceClosures:
         return self.falling_mass_flow_kg_s_m / (self.holdup_kg_per_m * self.rpm / 60.0)
 
     def to_dict(self) -> dict[str, Any]:
-        data = asdict(self)
+        data = {f.name: getattr(self, f.name) for f in fields(self)}
         data["window_s"] = list(self.window_s)
+        data["air"] = None if self.air is None else self.air.model_dump()
         data["froude"] = self.froude
         data["cascades_per_revolution"] = self.cascades_per_revolution
         return data
@@ -142,11 +150,13 @@ class SliceClosures:
     def from_dict(cls, data: dict[str, Any]) -> SliceClosures:
         """Inverse of :meth:`to_dict` (derived entries are ignored)."""
         names = {f for f in cls.__dataclass_fields__}
-        missing = sorted(names - set(data) - {"start_s"})
+        missing = sorted(names - set(data) - {"start_s", "air"})
         if missing:
             raise RunDirectoryError(f"closures: missing field(s) {', '.join(missing)}")
         values = {k: data[k] for k in names if k in data}
         values["window_s"] = tuple(values["window_s"])
+        if values.get("air") is not None and not isinstance(values["air"], AirClosures):
+            values["air"] = validate_air_closures(values["air"], str(data.get("source", "")))
         return cls(**values)
 
     def write(self, path: Path | str) -> Path:
@@ -197,6 +207,8 @@ class ClosuresFile(BaseModel):
     snapshots: int = Field(ge=1)
     window_s: list[float] = Field(min_length=2, max_length=2)
     start_s: float | None = Field(default=None, ge=0, allow_inf_nan=False)
+    # Files written before the air closures existed have none (or null).
+    air: AirClosures | None = None
 
     @field_validator("window_s")
     @classmethod
@@ -212,8 +224,14 @@ def _closure_problems(exc: ValidationError, data: dict[str, Any]) -> list[str]:
     for err in exc.errors():
         loc = err["loc"]
         name = ".".join(str(part) for part in loc) or "(file)"
-        top = loc[0] if loc else None
-        value = data.get(top) if isinstance(top, str) else None
+        value: Any = data
+        for part in loc:  # down to the value itself (the air closures are nested)
+            if isinstance(value, dict):
+                value = value.get(part)
+            elif isinstance(value, list) and isinstance(part, int) and part < len(value):
+                value = value[part]
+            else:
+                value = None
         shown = "missing" if err["type"] == "missing" else f"= {value!r}"
         lines.append(f"{name} {shown}: {err['msg']}")
     return lines
@@ -277,6 +295,11 @@ def bed_surface_length(x: FloatArray, y: FloatArray, radius: float, bin_width: f
 def _air_sampler(run_dir: Path, case: Case) -> Any:
     """The air velocity sampler of the run (lab frame), or None for still air."""
     field_path = run_dir / "air" / "field.npz"
+    if case.air.model == "cfd" and case.air.bed_states:
+        # The air around the bed (air.bed_states): what the loop's particles felt.
+        from drumflow.air.bed_phases import PhaseLockedAir
+
+        return PhaseLockedAir.from_run(run_dir / "air", case)
     if case.air.model == "cfd" and field_path.exists():
         from drumflow.air.field import AirField
 

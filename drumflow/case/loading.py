@@ -141,11 +141,19 @@ def load_case(path: Path | str) -> Case:
     if isinstance(run, dict) and isinstance(run.get("start_state"), str):
         # Relative to the case file, as written; the case holds it resolved, so that the copy
         # of the case in a run directory still names the same file.
-        state = Path(run["start_state"]).expanduser()
-        if not state.is_absolute():
-            run["start_state"] = str((Path(path).resolve().parent / state).resolve())
+        run["start_state"] = _beside(path, run["start_state"])
+    air = data.get("air")
+    if isinstance(air, dict) and isinstance(air.get("bed_states"), list):
+        # Relative to the case file, like run.start_state.
+        air["bed_states"] = [_beside(path, s) if isinstance(s, str) else s
+                             for s in air["bed_states"]]
     return case_from_dict(data, source=path)
 
+
+def _beside(case_file: Path | str, name: str) -> str:
+    """``name`` resolved against the case file's folder, unless absolute."""
+    state = Path(name).expanduser()
+    return str(state if state.is_absolute() else (Path(case_file).resolve().parent / state).resolve())
 
 
 def case_to_toml(case: Case) -> str:
@@ -153,4 +161,7 @@ def case_to_toml(case: Case) -> str:
     import tomli_w
 
     data = case.model_dump(mode="json", exclude_none=True)
+    if not data["air"].get("bed_states"):
+        # The empty drum's air, as every case wrote it before the option existed.
+        data["air"].pop("bed_states", None)
     return tomli_w.dumps(data)

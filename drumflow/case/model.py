@@ -140,6 +140,12 @@ class Case(_Section):
                 "air.warming = true: needs air (the coupling loop solves its temperature); "
                 "allowed with air.model = 'uniform' or 'cfd'"
             )
+        if self.air.bed_states and self.air.model != "cfd":
+            problems.append(
+                f"air.bed_states: {len(self.air.bed_states)} state(s) with air.model = "
+                f"'{self.air.model}': the air around the bed is solved by OpenFOAM; allowed with "
+                "air.model = 'cfd', or no bed states"
+            )
         if self.particles.interior == "shells" and self.air.model == "none":
             problems.append(
                 "particles.interior = 'shells': needs air (the coupling loop advances the shells "
@@ -253,6 +259,8 @@ class Case(_Section):
             # The state by its content, not its path: the path is resolved against the case
             # file, so it names the checkout's place, and a moved checkout must keep its runs.
             data["run"]["start_state"] = "sha256:" + hashlib.sha256(Path(state).read_bytes()).hexdigest()
+        if data["air"].get("bed_states"):
+            data["air"]["bed_states"] = [_by_content(s) for s in data["air"]["bed_states"]]
         return json.dumps(data, sort_keys=True, separators=(",", ":"))
 
     def hash(self) -> str:
@@ -273,6 +281,12 @@ class Case(_Section):
         return hashlib.sha256(json.dumps(sub, sort_keys=True).encode()).hexdigest()
 
 
+def _by_content(path: str) -> str:
+    """A state file by its content's hash (as run.start_state), its path if it is missing."""
+    return ("sha256:" + hashlib.sha256(Path(path).read_bytes()).hexdigest()
+            if Path(path).is_file() else path)
+
+
 #: Options that came after the first runs, each with the value that does what the code did
 #: before it existed: ``Case.canonical_json`` leaves them out at that value. Without this, a
 #: new option resets every run directory at ``drumflow run`` (a paper run of hours refused
@@ -288,6 +302,7 @@ _ADDED_LATER: tuple[tuple[str, str, object], ...] = (
     ("run", "start_state", None),
     ("drum", "ends", "fixed"),
     ("particles", "placement", "lattice"),
+    ("air", "bed_states", []),
 )
 
 #: The options of :data:`_ADDED_LATER` that came after section hashes (geometry cache, start

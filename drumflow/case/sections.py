@@ -235,6 +235,15 @@ class Air(_Section):
         "particle sees the air of its cell (drumflow.air.heat); false: the paper's one-way air "
         "at the inlet temperature everywhere",
     )
+    bed_states: list[str] = Field(
+        [], max_length=8, description="air around the bed (issue 32): bed "
+        "states of this scene (.npz, `drumflow export RUN_DIR --state --time T`) at drum angles "
+        "spread over one lifter spacing; the air stage solves the air with each state's bed as "
+        "Ergun porosity and periodic axial air (a piece of a long drum), and the coupling loop "
+        "uses the state nearest the drum's angle modulo the lifter spacing "
+        "(drumflow.air.bed_phases); paths relative to the case file; needs air.model = 'cfd'; "
+        "empty: the air of the empty drum",
+    )
 
 
 class Run(_Section):

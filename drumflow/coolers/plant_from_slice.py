@@ -11,6 +11,7 @@ puts it all in a run directory. Library code: it raises and writes files, it nev
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from dataclasses import dataclass, field
@@ -22,6 +23,7 @@ from pydantic import BaseModel, ConfigDict
 from drumflow.coolers.drum import MAX_CURTAIN_AIR_M3_S_M, DrumModelError
 
 if TYPE_CHECKING:
+    from drumflow.analysis.air_closures import AirClosures
     from drumflow.analysis.closures import SliceClosures
     from drumflow.coolers._transport import TransportLaw
     from drumflow.coolers.curtain_air import CurtainAirPoint, NeededCurtainAir
@@ -36,11 +38,12 @@ __all__ = ["PAPER_TABLE7", "DrumInputs", "PlantFromSlice", "PlantFromSliceFiles"
 #: Table 7 of the paper, model one: its exchanger prediction of the plant.
 PAPER_TABLE7 = {"material_outlet_C": 40.90, "air_outlet_C": 69.73}
 
-#: Why the through-curtain air defaults to 'all' (kept with every result).
+#: Why the through-curtain air defaults as it does (kept with every result).
 CURTAIN_AIR_DEFAULT_NOTE = (
-    "default 'all': all the air meets every falling granule, the limit of most contact and the "
-    "one setting not chosen from the plant; the through-curtain flow awaits a two-way-coupled "
-    "slice closure and is never fitted to the plant's outlets")
+    "default: the closures' own through-curtain air when they carry a periodic slice's air "
+    "closures (drumflow plant --curtain-air HEAT.json --save-closures), else 'all': all the air "
+    "meets every falling granule, the limit of most contact and the one setting not chosen from "
+    "the plant; the through-curtain flow is never fitted to the plant's outlets")
 
 #: Where the textbook volumetric coefficient comes from and how far it was checked.
 TEXTBOOK_NOTE = (
@@ -83,36 +86,35 @@ def slice_closures(source: Path, start: float | None) -> SliceClosures:
     return load_closures(source)
 
 
-def curtain_air_from_slice(path: Path) -> float:
-    """The through-curtain air a periodic slice measured: ``saturated_flow_m3_s_m`` of the
-    ``heat.json`` of ``drumflow bed-air --axial periodic --heat`` (its ``split.json`` beside it
-    says the set-up). The saturated flow is the air per metre that would leave at the particles'
-    mean temperature with the heat the slice's air took: what the plant model's through-curtain
-    stream stands for (chosen so when the bed-air heat was built, before any comparison).
+def curtain_air_from_slice(path: Path) -> AirClosures:
+    """The air closures of a periodic slice (:func:`drumflow.analysis.air_closures.read_air_closures`:
+    the ``heat.json`` of ``drumflow bed-air --axial periodic --heat``, the ``split.json`` and the
+    mixing bounds beside it). Their through-curtain air is the **saturated flow**, the air per
+    metre that would leave at the particles' mean temperature with the heat the slice's air
+    took: what the plant model's through-curtain stream stands for (chosen so when the bed-air
+    heat was built, before any comparison).
 
     Raises
     ------
     DrumModelError
-        The file missing or unreadable, no saturated flow in it, an inlet-outlet slice (a 0.1 m
-        slice's inlet forces fresh air through the bed: not a piece of a long drum), or a flow
-        outside 0 to :data:`MAX_CURTAIN_AIR_M3_S_M`.
+        The file missing or unreadable, an entry missing or out of range, an inlet-outlet
+        slice (a 0.1 m slice's inlet forces fresh air through the bed: not a piece of a long
+        drum), or a flow above :data:`MAX_CURTAIN_AIR_M3_S_M`; the message names the option
+        and the file.
     """
-    import json
+    from drumflow.analysis.air_closures import read_air_closures
+    from drumflow.errors import BadFileError
 
     try:
-        heat = json.loads(path.read_text())
-        axial = json.loads((path.parent / "split.json").read_text()).get("axial")
-        flow = float(heat["saturated_flow_m3_s_m"])
-    except (OSError, ValueError, KeyError, TypeError, AttributeError) as err:
-        raise DrumModelError(f"--curtain-air {path}: not a bed-air heat.json with its split.json "
-                             f"beside it ({type(err).__name__}: {err})") from None
-    if axial != "periodic":
-        raise DrumModelError(f"--curtain-air {path}: a slice solved with axial = {axial}; "
-                             "allowed: periodic (drumflow bed-air --axial periodic --heat)")
-    if not (math.isfinite(flow) and 0.0 <= flow <= MAX_CURTAIN_AIR_M3_S_M):
-        raise DrumModelError(f"--curtain-air {path}: saturated_flow_m3_s_m = {flow}: allowed 0 "
-                             f"to {MAX_CURTAIN_AIR_M3_S_M:g} m3/s per metre of drum")
-    return flow
+        air = read_air_closures(path)
+    except BadFileError as err:
+        raise DrumModelError(f"--curtain-air {path}: not a periodic slice's bed-air heat.json "
+                             f"with its split.json beside it: {err}") from None
+    if air.curtain_air_m3_s_m > MAX_CURTAIN_AIR_M3_S_M:
+        raise DrumModelError(f"--curtain-air {path}: saturated_flow_m3_s_m = "
+                             f"{air.curtain_air_m3_s_m}: allowed 0 to "
+                             f"{MAX_CURTAIN_AIR_M3_S_M:g} m3/s per metre of drum")
+    return air
 
 
 def is_slice_file(value: str) -> bool:
@@ -123,7 +125,7 @@ def is_slice_file(value: str) -> bool:
 
 def curtain_air_setting(value: str) -> float | None:
     """``--curtain-air``: 'all' (None), a flow in m3/s per metre of drum, or a periodic slice's
-    ``heat.json`` (:func:`curtain_air_from_slice`).
+    ``heat.json`` (its saturated flow, :func:`curtain_air_from_slice`).
 
     Raises
     ------
@@ -135,7 +137,7 @@ def curtain_air_setting(value: str) -> float | None:
     if value.strip().lower() == "all":
         return None
     if is_slice_file(value):
-        return curtain_air_from_slice(Path(value.strip()))
+        return curtain_air_from_slice(Path(value.strip())).curtain_air_m3_s_m
     try:
         flow = float(value)
     except ValueError:
@@ -204,7 +206,11 @@ class PlantFromSlice:
         The outlets over the through-curtain air (empty without the sweep), and the flow the
         plant's measured NPK outlet would need (the paper's plant only).
     curtain_air, curtain_air_from
-        The through-curtain flow asked for (None: 'all'); the slice file it came from, if any.
+        The through-curtain flow used (None: 'all'); the slice file it came from, if any.
+    mixing_bounds
+        The outlets at the slice's mixing bounds of the through-curtain air (molecular,
+        turbulent: :meth:`drumflow.analysis.air_closures.AirClosures.bounds`), when the flow
+        came from a slice that solved them; empty otherwise.
     """
 
     source: Path
@@ -221,6 +227,7 @@ class PlantFromSlice:
     exchanger: ExchangerResult
     curtain_air: float | None
     curtain_air_from: str | None = None
+    mixing_bounds: dict[str, CurtainAirPoint] = field(default_factory=dict)
     points: list[CurtainAirPoint] = field(default_factory=list)
     needed: NeededCurtainAir | None = None
 
@@ -256,6 +263,7 @@ class PlantFromSlice:
             "curtain_air": {
                 "setting_m3_s_per_m": self.curtain_air,
                 "from_slice": self.curtain_air_from,
+                "mixing_bounds": {name: point.to_dict() for name, point in self.mixing_bounds.items()},
                 "default_note": CURTAIN_AIR_DEFAULT_NOTE,
                 "sweep": [p.to_dict() for p in self.points],
                 "needed_for_measured_material_outlet": self.needed.to_dict() if self.needed else None,
@@ -275,7 +283,7 @@ def plant_from_slice(source: Path, *, cells: int = 40, rpm: float | None = None,
                      air_flow: float | None = None, feed_rate: float | None = None,
                      particle_diameter: float | None = None, length: float | None = None,
                      tilt: float | None = None, wall_loss: float = 0.0, lumped: bool = False,
-                     curtain_air: str = "all", sweep: bool = True,
+                     curtain_air: str | None = None, sweep: bool = True,
                      closures_start: float | None = None,
                      save_closures: Path | None = None) -> PlantFromSlice:
     """The paper's plant (or a what-if of it) by the axial drum model from a slice's closures.
@@ -292,14 +300,16 @@ def plant_from_slice(source: Path, *, cells: int = 40, rpm: float | None = None,
     wall_loss, lumped
         The shell's wall-loss coefficient U_w, W/(m2 K) (0: off); lumped particles (Bi -> 0).
     curtain_air
-        Air through the curtains, m3/s per metre of drum, or 'all'.
+        Air through the curtains: m3/s per metre of drum, 'all', or a periodic slice's
+        ``heat.json`` (its air closures then join the closures, and are saved with them);
+        None: the closures' own through-curtain air if they carry one, else 'all'.
     sweep
         Also evaluate the outlets over a range of the through-curtain air.
     closures_start
         With a run directory: measure the closures from this simulated time on, s.
     save_closures
-        Also write the slice closures to this JSON file, once the model accepted the inputs
-        (a refused call writes nothing).
+        Also write the slice closures (with the air closures, if any) to this JSON file, once
+        the model accepted the inputs (a refused call writes nothing).
 
     Raises
     ------
@@ -307,7 +317,11 @@ def plant_from_slice(source: Path, *, cells: int = 40, rpm: float | None = None,
         An option out of its bounds, or ``closures_start`` with a closures file.
     """
     from drumflow.coolers._transport import calibrate
-    from drumflow.coolers.curtain_air import curtain_air_for_outlet, sweep_curtain_air
+    from drumflow.coolers.curtain_air import (
+        CurtainAirPoint,
+        curtain_air_for_outlet,
+        sweep_curtain_air,
+    )
     from drumflow.coolers.drum import (
         DrumOptions,
         paper_exchanger,
@@ -320,11 +334,21 @@ def plant_from_slice(source: Path, *, cells: int = 40, rpm: float | None = None,
     changes = {"--rpm": rpm, "--air-flow": air_flow, "--feed-rate": feed_rate,
                "--particle-diameter": particle_diameter, "--length": length, "--tilt": tilt}
     check_what_if(changes, cells, wall_loss, closures_start)
-    curtain_flow = curtain_air_setting(curtain_air)
+    slice_air = (curtain_air_from_slice(Path(curtain_air.strip()))
+                 if curtain_air is not None and is_slice_file(curtain_air) else None)
+    curtain_flow = (None if curtain_air is None or slice_air is not None
+                    else curtain_air_setting(curtain_air))
     if particle_diameter is not None and particle_diameter > 0.05:
         raise DrumModelError(f"--particle-diameter = {particle_diameter}: allowed <= 0.05 m "
                              "(give it in metres)")
     closures = slice_closures(source, closures_start)
+    if slice_air is not None:
+        # The slice's air closures travel with the closures (--save-closures, result.json).
+        closures = dataclasses.replace(closures, air=slice_air)
+    elif curtain_air is None:
+        slice_air = closures.air
+    if slice_air is not None:
+        curtain_flow = slice_air.curtain_air_m3_s_m
     base = PAPER_PLANT
     # The transport law's one constant comes from the plant's measured residence time
     # (30 min), never from its outlet temperatures.
@@ -346,7 +370,11 @@ def plant_from_slice(source: Path, *, cells: int = 40, rpm: float | None = None,
         result=result, wall_s=wall,
         warnings=extrapolation_warnings(plant, base, closures, result.scaled) + result.warnings,
         textbook_ua=ua, textbook=textbook, exchanger=paper_exchanger(plant), curtain_air=curtain_flow,
-        curtain_air_from=curtain_air.strip() if is_slice_file(curtain_air) else None)
+        curtain_air_from=None if slice_air is None else slice_air.source,
+        mixing_bounds={} if slice_air is None else {
+            name: CurtainAirPoint.from_result(solve_drum(
+                plant, closures, law, dataclasses.replace(options, curtain_air_m3_s_m=flow)))
+            for name, flow in slice_air.bounds().items()})
     # The through-curtain flow is the closure no slice measures yet: show what it changes.
     if sweep:
         evaluation.points = sweep_curtain_air(plant, closures, law, options)

@@ -49,6 +49,7 @@ from typing import Any, Protocol
 import numpy as np
 from numpy.typing import NDArray
 
+from drumflow.air.bed_phases import PhaseLockedAir
 from drumflow.coupling.crossings import CrossingTracker
 from drumflow.coupling.interior import (
     INTERIOR_LOG_PATTERN,
@@ -98,7 +99,7 @@ class UniformAir:
 
 
 def air_velocity_at(
-    field: VelocityField,
+    field: VelocityField | PhaseLockedAir,
     x: NDArray[np.float64],
     time_s: float,
     omega: float,
@@ -107,24 +108,30 @@ def air_velocity_at(
 
     A field solved in the drum's rotating frame (MRF) turns with the drum: a lab position maps
     to the drum frame by a rotation of -omega t, and the sampled (absolute) velocity back by
-    +omega t. For a uniform axial field the rotation changes nothing.
+    +omega t. For a uniform axial field the rotation changes nothing. The air around the bed
+    (:class:`~drumflow.air.bed_phases.PhaseLockedAir`) maps by its phase's angle instead.
     """
+    if isinstance(field, PhaseLockedAir):
+        return field.sample_at(x, time_s)
     if omega == 0.0 or isinstance(field, UniformAir):
         return field.sample(x)
     angle = drum_angle(omega, time_s)
     return rotate_to_lab_frame(field.sample(rotate_to_drum_frame(x, angle)), angle)
 
 
-def load_field(spec: dict[str, Any]) -> VelocityField:
-    """The air field named by a spec: ``uniform`` (velocity) or ``grid`` (an .npz cache)."""
+def load_field(spec: dict[str, Any]) -> VelocityField | PhaseLockedAir:
+    """The air field named by a spec: ``uniform`` (velocity), ``grid`` (an .npz cache) or
+    ``phases`` (the air around the bed, one .npz per bed state)."""
     kind = spec["kind"]
+    if kind == "phases":
+        return PhaseLockedAir.from_spec(spec)
     if kind == "uniform":
         return UniformAir(tuple(spec["velocity"]))
     if kind == "grid":
         from drumflow.air.field import AirField
 
         return AirField.from_npz(Path(spec["path"]))
-    raise ValueError(f"air field kind {kind!r}: expected 'uniform' or 'grid'")
+    raise ValueError(f"air field kind {kind!r}: expected 'uniform', 'grid' or 'phases'")
 
 
 def _rank() -> int:
@@ -194,23 +201,31 @@ def air_load(air_velocity: NDArray[np.float64], velocity: NDArray[np.float64],
 #: Rank 0's log of the air's temperature (air.warming), beside the coupling logs.
 AIR_LOG_PATTERN = "coupling/air.{start}.csv"
 AIR_LOG_COLUMNS = ("step", "time_s", "steps", "heat_to_air_W", "air_enthalpy_gain_W",
-                   "outlet_C", "max_C", "wall_s")
+                   "outlet_C", "max_C", "wall_s", "phase")
 
 
 class _AirWarming:
     """The coupling loop's air that warms (:mod:`drumflow.air.heat`), one per rank: every rank
     holds the same grid and solves the same system from the heat summed over all ranks."""
 
-    def __init__(self, spec: dict[str, Any], field: VelocityField, rank: int, start: int) -> None:
+    def __init__(self, spec: dict[str, Any], field: VelocityField | PhaseLockedAir, rank: int,
+                 start: int) -> None:
         from drumflow.air.field import AirField
         from drumflow.air.heat import AirHeat, coarse_field
 
-        if not isinstance(field, AirField):
+        # The air around the bed: one air per bed state, each on its own flow; the one of the
+        # drum's phase is solved at each update (its last field is the next solve's start).
+        self.phases = field if isinstance(field, PhaseLockedAir) else None
+        fields = self.phases.fields if self.phases is not None else [field]
+        if not all(isinstance(f, AirField) for f in fields):
             raise ValueError("air.warming needs the air field on a grid (spec field kind 'grid')")
         warm = spec["warming"]
-        grid = coarse_field(field, float(warm["spacing"])) if warm.get("spacing") else field
-        self.heat = AirHeat(grid, float(spec["air_temperature_C"]), float(warm["density"]),
-                            float(warm["heat_capacity"]))
+        self.heats = [AirHeat(coarse_field(f, float(warm["spacing"])) if warm.get("spacing") else f,
+                              float(spec["air_temperature_C"]), float(warm["density"]),
+                              float(warm["heat_capacity"]))
+                      for f in fields if isinstance(f, AirField)]
+        self.phase = 0
+        self.heat = self.heats[0]
         self.omega = float(spec["omega"])
         self.rank = rank
         self.cells = np.zeros(0, dtype=np.intp)
@@ -229,7 +244,12 @@ class _AirWarming:
         ``conductance`` (W/K) and ``temperature`` (C) are each DEM sphere's film conductance to
         the air and the temperature behind it (the surface node)."""
         started = time.perf_counter()
-        points = rotate_to_drum_frame(x, drum_angle(self.omega, time_s)) if self.omega else x
+        if self.phases is not None:
+            self.phase, angle = self.phases.phase(time_s)
+            self.heat = self.heats[self.phase]
+        else:
+            angle = drum_angle(self.omega, time_s)
+        points = rotate_to_drum_frame(x, angle) if self.omega else x
         self.cells = self.heat.cells_of(points)
         g = allreduce_sum(self.heat.deposit(self.cells, conductance))
         gt = allreduce_sum(self.heat.deposit(self.cells, conductance * temperature))
@@ -246,7 +266,8 @@ class _AirWarming:
         self._wall += time.perf_counter() - started
         if self._log is not None:
             row = (step, time_s, n, float(source.sum()), self.heat.enthalpy_gain(solved),
-                   self.heat.outlet_temperature(solved), float(solved.max()), self._wall)
+                   self.heat.outlet_temperature(solved), float(solved.max()), self._wall,
+                   self.phase)
             self._log.write(",".join(f"{v:.12g}" for v in row) + "\n")
             self._log.flush()
 

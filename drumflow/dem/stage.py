@@ -335,6 +335,28 @@ def load_start_state(case: Case) -> StartState | None:
     return state
 
 
+def load_bed_states(case: Case) -> list[StartState]:
+    """The case's bed states for the air around the bed (``air.bed_states``), each checked
+    against its scene; empty without.
+
+    Raises
+    ------
+    StartStateError
+        A file that is not a start state, or another scene's, or of another particle count
+        (named as ``air.bed_states[k]``).
+    """
+    states = []
+    for k, name in enumerate(case.air.bed_states):
+        field = f"air.bed_states[{k}]"
+        try:
+            state = read_state(Path(name))
+        except StartStateError as err:
+            raise StartStateError(name, err.problem, field) from None
+        check_state(state, case, name, field)
+        states.append(state)
+    return states
+
+
 def _prepare_workdir(case: Case, rundir: RunDir, inputs: DemInputs, key: str,
                      state: StartState | None = None) -> tuple[Path, int] | None:
     """Create the DEM folders; return the restart to resume from, or start afresh (stale

@@ -288,8 +288,10 @@ def read_state(path: Path) -> StartState:
     return state
 
 
-def check_state(state: StartState, case: Case, path: Path | str) -> None:
-    """Refuse a state that does not belong to ``case``'s scene.
+def check_state(state: StartState, case: Case, path: Path | str,
+                field: str = "run.start_state") -> None:
+    """Refuse a state that does not belong to ``case``'s scene (``field``: the case field
+    that names it, for the message).
 
     Raises
     ------
@@ -302,11 +304,11 @@ def check_state(state: StartState, case: Case, path: Path | str) -> None:
         raise StartStateError(
             path, f"made for another scene (its drum, lifters and particles sections hash to "
             f"{state.scene_hash[:12]}, this case's to {want[:12]}; source case "
-            f"{state.case_hash[:12]}): start from a state of this scene")
+            f"{state.case_hash[:12]}): start from a state of this scene", field)
     count = case.dem_case().particle_count
     if len(state) != count:
         raise StartStateError(
-            path, f"holds {len(state):,} particles, the case {count:,}")
+            path, f"holds {len(state):,} particles, the case {count:,}", field)
 
 
 def start_step(state: StartState, time_step: float) -> int:

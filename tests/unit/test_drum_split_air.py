@@ -235,19 +235,27 @@ def test_the_curtain_air_comes_from_a_periodic_slice_file(tmp_path: Path) -> Non
     from drumflow.coolers.drum import DrumModelError
     from drumflow.coolers.plant_from_slice import curtain_air_setting
 
+    shipped = Path(__file__).resolve().parents[2] / "results" / "air" / \
+        "bed_air_model_two_5.0s_mesh0.1_periodic"
     heat, split = tmp_path / "heat.json", tmp_path / "split.json"
-    heat.write_text(json.dumps({"saturated_flow_m3_s_m": 1.25}))
-    split.write_text(json.dumps({"axial": "periodic"}))
+    warm, flow = json.loads((shipped / "heat.json").read_text()), json.loads(
+        (shipped / "split.json").read_text())
+    warm["saturated_flow_m3_s_m"] = 1.25
+    heat.write_text(json.dumps(warm))
+    split.write_text(json.dumps(flow))
     assert curtain_air_setting(str(heat)) == pytest.approx(1.25)
-    split.write_text(json.dumps({"axial": "inlet-outlet"}))
-    with pytest.raises(DrumModelError, match="axial = inlet-outlet; allowed: periodic"):
+    split.write_text(json.dumps({**flow, "axial": "inlet-outlet"}))
+    with pytest.raises(DrumModelError, match="axial = inlet-outlet: allowed periodic"):
         curtain_air_setting(str(heat))
-    split.write_text(json.dumps({"axial": "periodic"}))
-    heat.write_text(json.dumps({"saturated_flow_m3_s_m": -3.0}))
-    with pytest.raises(DrumModelError, match="saturated_flow_m3_s_m = -3.0"):
+    split.write_text(json.dumps(flow))
+    heat.write_text(json.dumps({**warm, "saturated_flow_m3_s_m": -3.0}))
+    with pytest.raises(DrumModelError, match="curtain_air_m3_s_m = -3.0"):
+        curtain_air_setting(str(heat))
+    heat.write_text(json.dumps({**warm, "saturated_flow_m3_s_m": 2e4}))
+    with pytest.raises(DrumModelError, match="saturated_flow_m3_s_m = 20000.0: allowed 0 to"):
         curtain_air_setting(str(heat))
     heat.write_text("{ truncated")
-    with pytest.raises(DrumModelError, match="heat.json: not a bed-air heat.json"):
+    with pytest.raises(DrumModelError, match="heat.json: not a periodic slice's bed-air heat.json"):
         curtain_air_setting(str(heat))
     with pytest.raises(DrumModelError, match="nothing.json"):
         curtain_air_setting(str(tmp_path / "nothing.json"))

@@ -34,14 +34,15 @@ def drum(
         "--wall-loss", help="wall-loss coefficient U_w, W/(m2 K) over the shell (0 = off)")] = 0.0,
     lumped: Annotated[bool, typer.Option(
         "--lumped", help="lumped particles (Bi -> 0) instead of interior conduction")] = False,
-    curtain_air: Annotated[str, typer.Option(
-        "--curtain-air", help="air through the curtains, m3/s per metre of drum (at the air "
+    curtain_air: Annotated[str | None, typer.Option(
+        "--curtain-air", help="air through the curtains: m3/s per metre of drum (at the air "
                               "inlet temperature), a periodic slice's heat.json (drumflow "
-                              "bed-air --heat: its saturated flow), or 'all': all the air "
-                              "meets every falling granule (the default: the one setting not "
-                              "chosen from the "
-                              "plant; the bound of most contact). Every run also reports the "
-                              "outlets over a range of it")] = "all",
+                              "bed-air --heat: its saturated flow; with --save-closures its air "
+                              "closures are saved too), or 'all': all the air meets every "
+                              "falling granule (the bound of most contact). Default: the "
+                              "closures' own through-curtain air if they carry a slice's, else "
+                              "'all'. Every run also reports the outlets over a range of it")
+    ] = None,
     sweep: Annotated[bool, typer.Option(
         "--sweep/--no-sweep", help="also run the range of through-curtain flows (table, "
                                    "curtain_air.csv/.png)")] = True,
@@ -80,6 +81,8 @@ def drum(
     for w in evaluation.warnings:
         err_console.print(f"[yellow]warning:[/] {w}", highlight=False)
     _print_outlets(evaluation)
+    if evaluation.mixing_bounds:
+        _print_mixing_bounds(evaluation)
     if evaluation.points:
         _print_curtain_air(evaluation)
     _print_model(evaluation, files, save_closures)
@@ -112,10 +115,27 @@ def _print_outlets(evaluation: PlantFromSlice) -> None:
     console.print(table)
 
 
+def _print_mixing_bounds(evaluation: PlantFromSlice) -> None:
+    """The outlets at the slice's bounds of the heat's mixing: the closure's own uncertainty."""
+    table = Table(title=f"through-curtain air from the slice ({evaluation.curtain_air_from}) "
+                        "and at its bounds of the heat's mixing")
+    table.add_column("")
+    table.add_column("through curtains (m³/s per m)", justify="right")
+    table.add_column("NPK out (°C)", justify="right")
+    table.add_column("air out (°C)", justify="right")
+    result = evaluation.result
+    table.add_row("the slice's closure", f"{evaluation.curtain_air:.3g}",
+                  f"{result.material_outlet_c:.2f}", f"{result.air_outlet_c:.2f}")
+    for name, point in evaluation.mixing_bounds.items():
+        table.add_row(f"{name} bound", f"{point.curtain_air_m3_s_m:.3g}",
+                      f"{point.material_outlet_c:.2f}", f"{point.air_outlet_c:.2f}")
+    console.print(table)
+
+
 def _print_curtain_air(evaluation: PlantFromSlice) -> None:
     """The outlets over the through-curtain air, and the flow the measured outlet would need."""
-    sweep_table = Table(title="over the air through the curtains (not yet measured by a "
-                              "slice; never fitted to the plant)")
+    sweep_table = Table(title="over the air through the curtains (a range; never fitted to "
+                              "the plant)")
     sweep_table.add_column("through curtains (m³/s per m)", justify="right")
     sweep_table.add_column("curtains met by the air", justify="right")
     sweep_table.add_column("NPK out (°C)", justify="right")
