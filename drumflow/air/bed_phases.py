@@ -32,6 +32,7 @@ from __future__ import annotations
 import json
 import math
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -167,12 +168,14 @@ class BedPhase:
 
 
 def solve_bed_phases(case: Case, states: list[BedSnapshot], workdir: Path, out: Path,
-                     runner: Runner, *, processes: int = 1,
-                     timeout: float | None = 7200.0) -> list[BedPhase]:
+                     runner: Runner, *, processes: int = 1, timeout: float | None = 7200.0,
+                     on_phase: Callable[[int, int], None] | None = None) -> list[BedPhase]:
     """Solve the air around each state's bed (periodic axial air), resample each onto the
     grid the loop samples, write ``out/bed_phase_<k>.npz`` and :data:`PHASES_RECORD`.
 
-    The empty drum is solved once and every bed case starts from it.
+    The empty drum is solved once and every bed case starts from it. ``on_phase(done, total)``
+    is called as each state's air is written (a progress bar: each takes minutes at paper
+    scale).
 
     Raises
     ------
@@ -195,6 +198,8 @@ def solve_bed_phases(case: Case, states: list[BedSnapshot], workdir: Path, out: 
         AirField.from_solution(result.bed_solution, case).to_npz(path)
         phases.append(BedPhase(path, float(state.drum_angle_rad), float(state.time_s),
                                state.source, result.as_dict()))
+        if on_phase is not None:
+            on_phase(k + 1, len(states))
     record = {"states": [{"path": str(p.path), "angle_rad": p.angle_rad, "time_s": p.time_s,
                           "source": p.source, "split": p.measures} for p in phases],
               "spacing_rad": lifter_spacing(case.lifters.count),

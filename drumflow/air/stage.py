@@ -217,8 +217,15 @@ def _with_bed_phases(case: Case, rundir: RunDir, runner: Runner, inputs: AirInpu
         work = rundir.air / "bed_openfoam"
         if work.exists():
             shutil.rmtree(work)
+        progress = inputs.progress
+
+        def on_phase(done: int, total: int) -> None:
+            if progress:
+                progress("air around the bed", float(done), float(total))
+
+        on_phase(0, len(inputs.bed_states))
         solve_bed_phases(case, list(inputs.bed_states), work, cache, runner,
-                         processes=inputs.processes)
+                         processes=inputs.processes, on_phase=on_phase)
     record = read_json_object(cache / PHASES_RECORD,
                               "the bed phases' cache record (delete its folder to solve again)")
     paths = []
