@@ -35,7 +35,11 @@ def export(
         "--out), for a case's run.start_state")] = False,
     time_s: Annotated[Optional[float], typer.Option(
         "--time", min=0.0, help="--state: the snapshot at this simulated time, s (default: the "
-        "newest)")] = None,
+        "newest); with --phases the first phase's")] = None,
+    phases: Annotated[Optional[int], typer.Option(
+        "--phases", min=1, max=8, help="--state: this many states spread over one lifter "
+        "period (the last the newest snapshot unless --time), into the --out folder (default "
+        "RUN_DIR), for a case's air.bed_states")] = None,
     out: Annotated[Optional[Path], typer.Option(
         "--out", "-o", help="output folder (--vtk, default RUN_DIR/vtk) or file (--animation: "
         "GIF, --state: .npz)")] = None,
@@ -50,6 +54,11 @@ def export(
         raise RunDirectoryError("choose one export format: --vtk, --animation or --state")
     if time_s is not None and not state:
         raise RunDirectoryError("--time is for --state (the snapshot to make the state of)")
+    if phases is not None and not state:
+        raise RunDirectoryError("--phases is for --state (states over a lifter period)")
+    if phases is not None:
+        _phase_states(run_dir, phases, time_s, out, as_json)
+        return
     if out is not None:
         # --vtk writes a folder of files, --animation and --state one file.
         (output_folder if vtk else output_file)(out)
@@ -93,6 +102,37 @@ def _state(run_dir: Path, time_s: float | None, out: Path | None, as_json: bool)
                   f"{start.drum_angle_rad:.6g} rad), {size / 1e6:.3f} MB "
                   f"({size / max(len(start), 1):.1f} bytes per particle); start a case from it "
                   "with run.start_state", highlight=False)
+
+
+def _phase_states(run_dir: Path, phases: int, time_s: float | None, out: Path | None,
+                  as_json: bool) -> None:
+    import math
+
+    from drumflow.case import load_case
+    from drumflow.dem.state import phase_states, write_state
+    from drumflow.readers import output_folder
+    from drumflow.rundir import RunDir
+
+    folder = output_folder(out) if out is not None else run_dir
+    states = phase_states(run_dir, phases, time_s)
+    folder.mkdir(parents=True, exist_ok=True)
+    paths = [write_state(s, folder / f"state_{s.time_s:.4g}s.npz") for s in states]
+    # Where each landed in the lifter period (the snapshots' spacing rounds the targets).
+    lifters = load_case(RunDir.existing(run_dir).case_toml).lifters.count
+    spacing = 2.0 * math.pi / lifters
+    offsets = [math.degrees((s.drum_angle_rad - states[0].drum_angle_rad) % spacing) for s in states]
+    records = [{"path": str(p), "time_s": s.time_s, "drum_angle_rad": s.drum_angle_rad,
+                "phase_deg": o, "target_phase_deg": math.degrees(spacing) * k / phases}
+               for k, (p, s, o) in enumerate(zip(paths, states, offsets, strict=True))]
+    if as_json:
+        console.print_json(json.dumps(records))
+        return
+    for r in records:
+        console.print(f"{r['path']}: t = {r['time_s']:.6g} s, {r['phase_deg']:.1f} degrees into the "
+                      f"{math.degrees(spacing):g}-degree lifter spacing (target "
+                      f"{r['target_phase_deg']:.1f})", highlight=False)
+    listed = ", ".join(f'"{p}"' for p in paths)
+    console.print(f"for the case file:\n[air]\nbed_states = [{listed}]", highlight=False)
 
 
 def _animation(run_dir: Path, out: Path | None, speed: float, as_json: bool) -> None:

@@ -47,6 +47,7 @@ if TYPE_CHECKING:
     from drumflow.dem.dumps import Snapshot
 
 __all__ = ["STATE_FORMAT", "SCENE_SECTIONS", "StartState", "check_state", "data_file_text",
+           "phase_states",
            "scene_hash", "state_from_run", "state_from_snapshot", "read_state",
            "temperature_file_text", "write_state"]
 
@@ -201,6 +202,44 @@ def state_from_run(run_dir: Path, time_s: float | None = None) -> StartState:
             f"{run.dem_dumps}: no full snapshot at t = {time_s:g} s (snapshots at "
             f"{', '.join(f'{t:g}' for t in times)} s)")
     return state_from_snapshot(read_dump(files[best]), case.dem_case(), dt, str(files[best]))
+
+
+def phase_states(run_dir: Path, phases: int, start_s: float | None = None) -> list[StartState]:
+    """``phases`` start states spread over one lifter period 60 / (rpm lifters), for a case's
+    ``air.bed_states``: the snapshots nearest ``start_s + k period / phases`` (default
+    ``start_s``: the newest snapshot's time less ``(phases - 1) / phases`` of a period, so the
+    last is the newest).
+
+    Raises
+    ------
+    RunDirectoryError
+        A drum without lifters (one state is every phase), ``phases`` outside 1-8, a start
+        before the first snapshot, or a time with no snapshot near it (:func:`state_from_run`).
+    """
+    from drumflow.case import load_case
+    from drumflow.dem.dumps import dump_files, dump_step
+    from drumflow.rundir import RunDir
+
+    if not 1 <= phases <= 8:
+        raise RunDirectoryError(f"--phases = {phases}: allowed 1 to 8 (air.bed_states holds at most 8)")
+    run = RunDir.existing(run_dir)
+    run.require(run.case_toml)
+    case = load_case(run.case_toml)
+    if case.lifters.count == 0:
+        raise RunDirectoryError(f"{run.root}: a drum without lifters looks the same at every "
+                                "angle; one state (--state alone) stands for every phase")
+    period = 60.0 / (case.drum.rpm * case.lifters.count)
+    dt = float((run.manifest.get("time_step") or {}).get("time_step", math.nan))
+    files = dump_files(run.dem_dumps, "snap")
+    if not files or not math.isfinite(dt):
+        raise RunDirectoryError(f"{run.dem_dumps}: no full snapshots of a DEM run")
+    first, newest = dump_step(files[0]) * dt, dump_step(files[-1]) * dt
+    start = newest - period * (phases - 1) / phases if start_s is None else start_s
+    if start < first - 0.5 * dt:
+        raise RunDirectoryError(f"--time = {start:g} s: the first snapshot is at {first:g} s; "
+                                f"{phases} phases of the {period:g} s lifter period need "
+                                f"snapshots from {start:g} to {start + period * (phases - 1) / phases:g} s")
+    return [state_from_run(run_dir, start + k * period / phases) for k in range(phases)]
 
 
 def write_state(state: StartState, path: Path) -> Path:

@@ -129,3 +129,31 @@ def test_animation_has_a_frame_per_snapshot(run_dir: Path, tmp_path: Path) -> No
     assert info["fps"] == 10
     lo, hi = info["temperature_range_C"]
     assert lo < hi <= 90.0 + 1e-6  # the particles start at 90 C and only cool
+
+
+@pytest.mark.timeout(300)
+def test_states_over_a_lifter_period(run_dir: Path, tmp_path: Path) -> None:
+    """--state --phases 3 --time 0.1: the tiny drum's 6 lifters at 30 rpm pass every 1/3 s, so
+    the targets are 0.1, 0.211 and 0.322 s; the snapshots every 0.1 s give 0.1, 0.2 and 0.3 s,
+    18 and 36 degrees into the 60-degree spacing against the targets' 20 and 40."""
+    from drumflow.dem.state import read_state
+
+    proc = subprocess.run(
+        [sys.executable, "-m", "drumflow.cli", "export", str(run_dir), "--state", "--phases", "3",
+         "--time", "0.1", "--out", str(tmp_path / "phases"), "--json"],
+        capture_output=True, text=True, timeout=300, check=False)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    records = json.loads(proc.stdout)
+    assert [round(r["time_s"], 3) for r in records] == [0.1, 0.2, 0.3]
+    assert [round(r["target_phase_deg"], 1) for r in records] == [0.0, 20.0, 40.0]
+    # The drum turned pi rad/s: the phases are the states' own angles, read back from the files.
+    angles = [read_state(Path(r["path"])).drum_angle_rad for r in records]
+    phases = [math.degrees((a - angles[0]) % (math.pi / 3)) for a in angles]
+    assert phases == pytest.approx([0.0, 18.0, 36.0], abs=0.1)
+    assert [r["phase_deg"] for r in records] == pytest.approx(phases, abs=1e-9)
+    # A period that runs past the last snapshot (0.35 + 1/6 s > 0.4 s): refused by name.
+    late = subprocess.run(
+        [sys.executable, "-m", "drumflow.cli", "export", str(run_dir), "--state", "--phases", "2",
+         "--time", "0.35", "--out", str(tmp_path / "late")],
+        capture_output=True, text=True, timeout=300, check=False)
+    assert late.returncode == 2 and "no full snapshot at t = 0.516667 s" in " ".join(late.stderr.split())

@@ -18,6 +18,9 @@ import pytest
         (["--vtk", "--animation"], "choose one export format: --vtk, --animation or --state"),
         (["--vtk", "--time", "1.0"], "--time is for --state"),
         (["--state"], "no case.toml"),
+        (["--vtk", "--phases", "2"], "--phases is for --state"),
+        (["--state", "--phases", "9"], "--phases"),
+        (["--state", "--phases", "2"], "no case.toml"),
     ],
 )
 def test_export_bad_input(tmp_path: Path, args: list[str], message: str) -> None:
