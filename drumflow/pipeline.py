@@ -439,7 +439,13 @@ def _air_warming_summary(rundir: RunDir, until_s: float, removed_J: float,
     held = air["steps"].to_numpy(float) * time_step
     gain = float(np.sum(air["air_enthalpy_gain_W"].to_numpy(float) * held))
     last = air[air["time_s"] >= max(0.0, until_s - 1.0)]
+    # The heat the air took over the heat if every particle had met inlet air through the same
+    # film (logs written before the column existed have none).
+    fresh = (float(np.sum(air["heat_if_fresh_W"].to_numpy(float) * held))
+             if "heat_if_fresh_W" in air else math.nan)
+    taken = float(np.sum(air["heat_to_air_W"].to_numpy(float) * held))
     return {
+        "contact_efficiency": taken / fresh if fresh > 0 else math.nan,
         "air_enthalpy_gain_J": gain,
         "air_energy_balance_error": abs(gain - removed_J) / abs(removed_J) if removed_J else float("nan"),
         "air_outlet_temperature_C": float(last["outlet_C"].mean()),

@@ -35,21 +35,32 @@ import pandas as pd
 import tomli_w
 
 ROOT = Path(__file__).resolve().parents[1]
-#: The levels, as (name, particles.interior, air.warming).
-LEVELS = (("lumped", "lumped", False), ("shells", "shells", False), ("shells_warming", "shells", True))
+#: The levels, as (name, particles.interior, air.warming, air around the bed). The last needs
+#: ``--bed-states`` (issue 32: ``drumflow export RUN --state --phases N``).
+LEVELS = (("lumped", "lumped", False, False), ("shells", "shells", False, False),
+          ("shells_warming", "shells", True, False), ("around_bed", "shells", True, True))
 #: The plant's measured volumetric coefficient (issue 34: its outlets imply 200-320 W/(m3 K)).
 PLANT_UA = 290.0
 
 
-def level_case(model: str, level: tuple[str, str, bool], coarse_grain: float, end: float,
-               folder: Path) -> Path:
-    """The shipped case with only the level, the parcels and the end changed."""
-    name, interior, warming = level
+def level_case(model: str, level: tuple[str, str, bool, bool], coarse_grain: float, end: float,
+               folder: Path, bed_states: list[Path] | None = None,
+               mesh_size: float | None = None) -> Path:
+    """The shipped case with only the level, the parcels and the end changed (and, when given,
+    the air mesh: the air around the bed solves the porous drum once per state)."""
+    name, interior, warming, around = level
     data = tomllib.loads((ROOT / "cases" / f"paper_model_{model}.toml").read_text())
-    data["name"] = f"paper_model_{model}_{name}_cg{coarse_grain:g}"
+    mesh = "" if mesh_size is None else f"_mesh{mesh_size:g}"
+    data["name"] = f"paper_model_{model}_{name}_cg{coarse_grain:g}{mesh}"
     data["particles"]["interior"] = interior
     if warming:
         data["air"]["warming"] = True
+    if around:
+        if not bed_states:
+            raise SystemExit(f"level {name}: give --bed-states (drumflow export RUN --state --phases N)")
+        data["air"]["bed_states"] = [str(p.resolve()) for p in bed_states]
+    if mesh_size is not None:
+        data["air"]["mesh_size"] = mesh_size
     data["particles"]["coarse_grain"] = coarse_grain
     data["run"]["time"] = end
     folder.mkdir(parents=True, exist_ok=True)
@@ -133,6 +144,12 @@ def measure(out: Path, at_s: float, until_s: float) -> dict[str, Any]:
         air = pd.concat([pd.read_csv(p) for p in air_logs])
         air = air[(air["time_s"] >= 1.0) & (air["time_s"] <= until_s)]
         outlet = float(air["outlet_C"].mean())
+    contact = math.nan
+    if air_logs and "heat_if_fresh_W" in air:
+        contact = float(air["heat_to_air_W"].sum() / air["heat_if_fresh_W"].sum())
+    from drumflow.physics.air import ideal_gas_density
+
+    rho = ideal_gas_density(t_air, case.air.pressure_kPa)
     d_in, d_out = t_particles - t_air, t_particles - outlet
     lmtd = (d_in - d_out) / math.log(d_in / d_out) if abs(d_in - d_out) > 1e-9 else d_in
     return {
@@ -145,6 +162,12 @@ def measure(out: Path, at_s: float, until_s: float) -> dict[str, Any]:
         "air_outlet_solved_C": outlet if air_logs else math.nan,
         "volumetric_coefficient_W_m3K": heat_w / (volume * (t_particles - t_air)),
         "volumetric_coefficient_lmtd_W_m3K": heat_w / (volume * lmtd),
+        # The heat the air took over the heat with inlet air at every particle (air that warms
+        # only), and the air per metre that the heat would bring to the particles' mean
+        # temperature (the plant's through-curtain closure, as drumflow bed-air --heat defines it).
+        "contact_efficiency": contact,
+        "saturated_flow_m3_s_m": heat_w / (rho * case.air.heat_capacity * (t_particles - t_air)
+                                           * case.drum.length),
         "plant_volumetric_coefficient_W_m3K": PLANT_UA,
         "energy_balance_error": summary.get("energy_balance_error"),
         "simulated_s": summary.get("simulated_time_s"),
@@ -165,8 +188,12 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--lumped-from", type=Path, default=None,
                         help="a finished lumped run (or shipped results) of the same case and "
                         "parcels, measured over the same window instead of running it again")
-    parser.add_argument("--levels", nargs="+", default=[name for name, *_ in LEVELS],
+    parser.add_argument("--levels", nargs="+", default=[name for name, *_ in LEVELS[:3]],
                         choices=[name for name, *_ in LEVELS])
+    parser.add_argument("--bed-states", nargs="+", type=Path, default=None,
+                        help="the around_bed level's air.bed_states (this scene's states)")
+    parser.add_argument("--mesh-size", type=float, default=None,
+                        help="air.mesh_size of every level run here, m (default the case's)")
     parser.add_argument("--note", default="", help="what else ran on the machine, for the record")
     args = parser.parse_args(argv)
     rows = []
@@ -177,7 +204,8 @@ def main(argv: list[str] | None = None) -> int:
             out = args.lumped_from
             name = str(out.resolve().relative_to(ROOT)) if out.resolve().is_relative_to(ROOT) else out.name
         else:
-            case = level_case(args.model, level, args.coarse_grain, args.time, args.runs / "cases")
+            case = level_case(args.model, level, args.coarse_grain, args.time, args.runs / "cases",
+                              args.bed_states, args.mesh_size)
             out = args.runs / case.stem
             run(case, out)
             # Measured from the shipped copy, so the table can be made again from the repository.
@@ -186,7 +214,8 @@ def main(argv: list[str] | None = None) -> int:
         rows.append({"model": args.model, "level": level[0], "run": name, **measure(out, 3.5, args.time)})
     table = pd.DataFrame(rows)
     args.out.mkdir(parents=True, exist_ok=True)
-    stem = f"levels_model_{args.model}_cg{args.coarse_grain:g}"
+    mesh = "" if args.mesh_size is None else f"_mesh{args.mesh_size:g}"
+    stem = f"levels_model_{args.model}_cg{args.coarse_grain:g}{mesh}"
     table.to_csv(args.out / f"{stem}.csv", index=False, float_format="%.6g")
     (args.out / f"{stem}.json").write_text(json.dumps(
         {"machine": subprocess.run(["uname", "-a"], capture_output=True, text=True).stdout.strip(),

@@ -201,7 +201,7 @@ def air_load(air_velocity: NDArray[np.float64], velocity: NDArray[np.float64],
 #: Rank 0's log of the air's temperature (air.warming), beside the coupling logs.
 AIR_LOG_PATTERN = "coupling/air.{start}.csv"
 AIR_LOG_COLUMNS = ("step", "time_s", "steps", "heat_to_air_W", "air_enthalpy_gain_W",
-                   "outlet_C", "max_C", "wall_s", "phase")
+                   "outlet_C", "max_C", "wall_s", "phase", "heat_if_fresh_W")
 
 
 class _AirWarming:
@@ -225,6 +225,7 @@ class _AirWarming:
                               float(warm["heat_capacity"]))
                       for f in fields if isinstance(f, AirField)]
         self.phase = 0
+        self._fresh = 0.0
         self.heat = self.heats[0]
         self.omega = float(spec["omega"])
         self.rank = rank
@@ -253,6 +254,9 @@ class _AirWarming:
         self.cells = self.heat.cells_of(points)
         g = allreduce_sum(self.heat.deposit(self.cells, conductance))
         gt = allreduce_sum(self.heat.deposit(self.cells, conductance * temperature))
+        # The heat if every particle met air at the inlet temperature through the same film:
+        # the contact efficiency's denominator (heat_to_air_W over it).
+        self._fresh = float(gt.sum() - g.sum() * self.heat.inlet_temperature_C)
         cell_temperature = self.heat.solve_with_particles(g, gt)
         self._wall = time.perf_counter() - started
         return np.asarray(cell_temperature[self.cells], dtype=float)
@@ -267,7 +271,7 @@ class _AirWarming:
         if self._log is not None:
             row = (step, time_s, n, float(source.sum()), self.heat.enthalpy_gain(solved),
                    self.heat.outlet_temperature(solved), float(solved.max()), self._wall,
-                   self.phase)
+                   self.phase, self._fresh)
             self._log.write(",".join(f"{v:.12g}" for v in row) + "\n")
             self._log.flush()
 

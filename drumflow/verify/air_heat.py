@@ -113,5 +113,9 @@ def air_heat_check(work: Path, runner: Runner, h_factor: float = 1.0) -> Check:
         wall_time_s=time.perf_counter() - t0,
         details={"ntu": ntu, "outlet_C": float(last["outlet_C"]), "h_factor": h_factor,
                  "air_enthalpy_gain_W": float(last["air_enthalpy_gain_W"]),
-                 "heat_to_air_W": float(last["heat_to_air_W"])},
+                 "heat_to_air_W": float(last["heat_to_air_W"]),
+                 # The heat taken over the heat with inlet air at every particle: epsilon / NTU
+                 # for a stream past a surface at one temperature.
+                 "contact_efficiency": float(last["heat_to_air_W"]) / float(last["heat_if_fresh_W"]),
+                 "contact_efficiency_exact": (1.0 - math.exp(-ntu)) / ntu},
     )

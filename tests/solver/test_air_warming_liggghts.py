@@ -21,9 +21,15 @@ def test_plug_flow_column_warms_as_epsilon_ntu_and_a_wrong_law_fails(tmp_path: P
     assert check.passed, check
     # Bookkeeping beside it: the air carried out what the particles gave, to round-off.
     assert check.details["air_enthalpy_gain_W"] == pytest.approx(check.details["heat_to_air_W"], rel=1e-9)
+    # The contact efficiency the loop logs is epsilon / NTU (1 %, as the rise).
+    assert check.details["contact_efficiency"] == pytest.approx(
+        check.details["contact_efficiency_exact"], rel=TOLERANCE)
     for factor in (0.9, 1.1):
         wrong = air_heat_check(tmp_path / f"h{factor}", Runner(), h_factor=factor)
         assert not wrong.passed and wrong.error > 3 * TOLERANCE, wrong
+        # Against the wrong law's epsilon / NTU the logged efficiency misses by 4-5 %.
+        off = wrong.details["contact_efficiency"] / wrong.details["contact_efficiency_exact"] - 1.0
+        assert abs(off) > 3 * TOLERANCE, off
 
 
 @pytest.mark.timeout(900)
@@ -42,6 +48,8 @@ def test_tiny_drum_air_that_warms_cools_the_bed_less_and_closes_energy(tmp_path:
     cooled = {k: 90.0 - s["mean_temperature_C"] for k, s in (("one_way", one_way), ("warming", warming))}
     assert cooled["warming"] < 0.97 * cooled["one_way"], cooled
     assert warming["air_energy_balance_error"] < 1e-6
+    # Air that warms leaves the bed less of the film's drive than fresh air would.
+    assert 0.0 < warming["contact_efficiency"] < 1.0
     # 0.1 kg/s of air taking the bed's heat leaves warmer by about Q / (m_dot c_p).
     rise = warming["air_outlet_temperature_C"] - 30.0
     assert rise == pytest.approx(warming["mean_heat_removal_W"] / (0.1 * 1005.0), rel=0.3)
