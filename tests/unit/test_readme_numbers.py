@@ -29,6 +29,7 @@ SPIN = "results/bench/paper_model_two_spin/ladder.csv"
 CG_LADDER = "results/bench/paper_model_two_ladder/ladder.csv"
 MEASURED = "results/bench/paper_model_two_ladder_measured/ladder.csv"
 PERIODIC = "docs/plant/paper_model_one_plant_periodic.json"
+AIR_CLOSURES = "docs/plant/paper_model_one_plant_air_closures.json"
 
 #: (text typed in the README with its number in brackets, file, key, format). The text without
 #: the brackets is searched as it stands in a sentence; the value read from the file, formatted,
@@ -56,6 +57,12 @@ TYPED: list[tuple[str, str, str, str]] = [
      "curtain_air.setting_m3_s_per_m", ".2f"),
     ("gives [40.6] °C", "docs/plant/paper_model_one_plant_periodic_curtains.json",
      "material_outlet_temperature_C", ".1f"),
+    ("mixing ([3.22]-19.2)", AIR_CLOSURES,
+     "curtain_air.mixing_bounds.molecular.curtain_air_m3_s_per_m", ".2f"),
+    ("mixing (3.22-[19.2])", AIR_CLOSURES,
+     "curtain_air.mixing_bounds.turbulent.curtain_air_m3_s_per_m", ".1f"),
+    ("gives [39.0]-31.5 °C", AIR_CLOSURES, "curtain_air.mixing_bounds.molecular.material_outlet_C", ".1f"),
+    ("gives 39.0-[31.5] °C", AIR_CLOSURES, "curtain_air.mixing_bounds.turbulent.material_outlet_C", ".1f"),
     ("flow by [5.4] %", SPIN, "default_step.error_steady_mass_flow", ".1%"),
     ("heat answer to\n  [0.35] %", CG_LADDER, "parcels.error_h", ".2%"),
     ("flow by [7.5] %", CG_LADDER, "parcels.error_steady_mass_flow", ".1%"),
