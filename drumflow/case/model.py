@@ -255,10 +255,10 @@ class Case(_Section):
             for name in ("stop_tolerance", "stop_min_time"):
                 del data["run"][name]
         state = data["run"].get("start_state")
-        if state is not None and Path(state).is_file():
+        if state is not None:
             # The state by its content, not its path: the path is resolved against the case
             # file, so it names the checkout's place, and a moved checkout must keep its runs.
-            data["run"]["start_state"] = "sha256:" + hashlib.sha256(Path(state).read_bytes()).hexdigest()
+            data["run"]["start_state"] = _by_content(state)
         if data["air"].get("bed_states"):
             data["air"]["bed_states"] = [_by_content(s) for s in data["air"]["bed_states"]]
         return json.dumps(data, sort_keys=True, separators=(",", ":"))

@@ -108,6 +108,7 @@ def _phase_states(run_dir: Path, phases: int, time_s: float | None, out: Path | 
                   as_json: bool) -> None:
     import math
 
+    from drumflow.air.bed_phases import lifter_spacing
     from drumflow.case import load_case
     from drumflow.dem.state import phase_states, write_state
     from drumflow.readers import output_folder
@@ -118,8 +119,8 @@ def _phase_states(run_dir: Path, phases: int, time_s: float | None, out: Path | 
     folder.mkdir(parents=True, exist_ok=True)
     paths = [write_state(s, folder / f"state_{s.time_s:.4g}s.npz") for s in states]
     # Where each landed in the lifter period (the snapshots' spacing rounds the targets).
-    lifters = load_case(RunDir.existing(run_dir).case_toml).lifters.count
-    spacing = 2.0 * math.pi / lifters
+    spacing = lifter_spacing(load_case(RunDir.existing(run_dir).case_toml).lifters.count)
+    assert spacing is not None  # phase_states refused a drum without lifters
     offsets = [math.degrees((s.drum_angle_rad - states[0].drum_angle_rad) % spacing) for s in states]
     records = [{"path": str(p), "time_s": s.time_s, "drum_angle_rad": s.drum_angle_rad,
                 "phase_deg": o, "target_phase_deg": math.degrees(spacing) * k / phases}
