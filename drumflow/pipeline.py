@@ -38,10 +38,9 @@ from drumflow.dem.stage import (
     ProgressCallback,
     clear_stop_request,
     kept_time_step,
-    load_bed_states,
-    load_start_state,
     plan_run,
 )
+from drumflow.dem.state import load_bed_states, load_start_state
 from drumflow.dem.thermo import read_thermo
 from drumflow.dem.timestep import TimeStepChoice, choose_time_step
 from drumflow.errors import BadFileError, CaseError, RunDirectoryError

@@ -83,7 +83,7 @@ class AirInputs:
         ``progress(stage, done, total)``: SIMPLE iterations of the ``"air"`` stage.
     bed_states
         The states of ``air.bed_states``, read and checked against the scene by the caller
-        (:func:`drumflow.dem.stage.load_bed_states`): the air around each one's bed is solved
+        (:func:`drumflow.dem.state.load_bed_states`): the air around each one's bed is solved
         (:mod:`drumflow.air.bed_phases`).
     """
 
@@ -206,7 +206,7 @@ def _with_bed_phases(case: Case, rundir: RunDir, runner: Runner, inputs: AirInpu
 
     if len(inputs.bed_states) != len(case.air.bed_states):
         raise ValueError(f"air.bed_states names {len(case.air.bed_states)} state(s), the stage "
-                         f"was given {len(inputs.bed_states)} (drumflow.dem.stage.load_bed_states)")
+                         f"was given {len(inputs.bed_states)} (drumflow.dem.state.load_bed_states)")
     contents = [hashlib.sha256(Path(p).read_bytes()).hexdigest() for p in case.air.bed_states]
     key = hash_text(json.dumps({"air": empty.source.key, "states": contents,
                                 "version": BED_PHASES_VERSION}))

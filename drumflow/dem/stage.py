@@ -50,9 +50,8 @@ from drumflow.dem.stability import (
 )
 from drumflow.dem.state import (
     StartState,
-    check_state,
     data_file_text,
-    read_state,
+    load_start_state,
     start_step,
     temperature_file_text,
 )
@@ -313,48 +312,6 @@ def _tidy_output(restarts: Path, dumps: Path, finished: bool) -> None:
 def _stability_record(limits: StabilityLimits, monitor: StabilityMonitor, stopped: bool) -> dict[str, Any]:
     return {"limits": limits.as_dict(), "stopped": stopped, "warnings": list(monitor.warnings),
             "max_overlap_m": monitor.max_overlap, "max_kinetic_energy_J": monitor.max_kinetic_energy}
-
-
-def load_start_state(case: Case) -> StartState | None:
-    """The case's start state (``run.start_state``), checked against its scene; None without.
-
-    Raises
-    ------
-    StartStateError
-        The file is not a start state, or it is another scene's or holds another particle count.
-    """
-    if case.run.start_state is None:
-        return None
-    path = Path(case.run.start_state)
-    state = read_state(path)
-    check_state(state, case, path)
-    if case.run.time <= state.time_s:
-        raise StartStateError(
-            case.run.start_state, f"the state is at t = {state.time_s:.6g} s, run.time "
-            f"= {case.run.time:g} s ends before it: run.time is the end time, counted from 0")
-    return state
-
-
-def load_bed_states(case: Case) -> list[StartState]:
-    """The case's bed states for the air around the bed (``air.bed_states``), each checked
-    against its scene; empty without.
-
-    Raises
-    ------
-    StartStateError
-        A file that is not a start state, or another scene's, or of another particle count
-        (named as ``air.bed_states[k]``).
-    """
-    states = []
-    for k, name in enumerate(case.air.bed_states):
-        field = f"air.bed_states[{k}]"
-        try:
-            state = read_state(Path(name))
-        except StartStateError as err:
-            raise StartStateError(name, err.problem, field) from None
-        check_state(state, case, name, field)
-        states.append(state)
-    return states
 
 
 def _prepare_workdir(case: Case, rundir: RunDir, inputs: DemInputs, key: str,

@@ -47,7 +47,7 @@ if TYPE_CHECKING:
     from drumflow.dem.dumps import Snapshot
 
 __all__ = ["STATE_FORMAT", "SCENE_SECTIONS", "StartState", "check_state", "data_file_text",
-           "phase_states",
+           "load_bed_states", "load_start_state", "phase_states",
            "scene_hash", "state_from_run", "state_from_snapshot", "read_state",
            "temperature_file_text", "write_state"]
 
@@ -348,6 +348,48 @@ def check_state(state: StartState, case: Case, path: Path | str,
     if len(state) != count:
         raise StartStateError(
             path, f"holds {len(state):,} particles, the case {count:,}", field)
+
+
+def load_start_state(case: Case) -> StartState | None:
+    """The case's start state (``run.start_state``), checked against its scene; None without.
+
+    Raises
+    ------
+    StartStateError
+        The file is not a start state, or it is another scene's or holds another particle count.
+    """
+    if case.run.start_state is None:
+        return None
+    path = Path(case.run.start_state)
+    state = read_state(path)
+    check_state(state, case, path)
+    if case.run.time <= state.time_s:
+        raise StartStateError(
+            case.run.start_state, f"the state is at t = {state.time_s:.6g} s, run.time "
+            f"= {case.run.time:g} s ends before it: run.time is the end time, counted from 0")
+    return state
+
+
+def load_bed_states(case: Case) -> list[StartState]:
+    """The case's bed states for the air around the bed (``air.bed_states``), each checked
+    against its scene; empty without.
+
+    Raises
+    ------
+    StartStateError
+        A file that is not a start state, or another scene's, or of another particle count
+        (named as ``air.bed_states[k]``).
+    """
+    states = []
+    for k, name in enumerate(case.air.bed_states):
+        field = f"air.bed_states[{k}]"
+        try:
+            state = read_state(Path(name))
+        except StartStateError as err:
+            raise StartStateError(name, err.problem, field) from None
+        check_state(state, case, name, field)
+        states.append(state)
+    return states
 
 
 def start_step(state: StartState, time_step: float) -> int:

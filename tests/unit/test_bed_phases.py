@@ -158,7 +158,7 @@ def test_bed_states_need_cfd_air(tmp_path) -> None:  # type: ignore[no-untyped-d
 
 
 def test_a_bed_state_of_another_scene_is_refused_by_its_field(tmp_path) -> None:  # type: ignore[no-untyped-def]
-    from drumflow.dem.stage import load_bed_states
+    from drumflow.dem.state import load_bed_states
     from drumflow.errors import StartStateError
 
     model_two = ROOT / "results" / "states" / "paper_model_two_cg2_5.0s.npz"
