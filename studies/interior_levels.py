@@ -45,13 +45,13 @@ PLANT_UA = 290.0
 
 def level_case(model: str, level: tuple[str, str, bool, bool], coarse_grain: float, end: float,
                folder: Path, bed_states: list[Path] | None = None,
-               mesh_size: float | None = None) -> Path:
+               mesh_size: float | None = None, suffix: str = "") -> Path:
     """The shipped case with only the level, the parcels and the end changed (and, when given,
     the air mesh: the air around the bed solves the porous drum once per state)."""
     name, interior, warming, around = level
     data = tomllib.loads((ROOT / "cases" / f"paper_model_{model}.toml").read_text())
     mesh = "" if mesh_size is None else f"_mesh{mesh_size:g}"
-    data["name"] = f"paper_model_{model}_{name}_cg{coarse_grain:g}{mesh}"
+    data["name"] = f"paper_model_{model}_{name}_cg{coarse_grain:g}{mesh}{suffix}"
     data["particles"]["interior"] = interior
     if warming:
         data["air"]["warming"] = True
@@ -92,12 +92,29 @@ def ship(out: Path, folder: Path) -> Path:
         if (out / name).exists():
             (folder / name).parent.mkdir(parents=True, exist_ok=True)
             shutil.copyfile(out / name, folder / name)
+    _relative_bed_states(folder / "case.toml")
     logs = folder / "dem" / "coupling"
     logs.mkdir(parents=True, exist_ok=True)
     coupling = out / "dem" / "coupling"
     for log in [*coupling.glob("*rank*.csv"), *coupling.glob("air.*.csv")]:
         shutil.copyfile(log, logs / log.name)
     return folder
+
+
+def _relative_bed_states(case_file: Path) -> None:
+    """Name the shipped case's bed states relative to it (the loader resolves them beside the
+    case file), so that the shipped case loads, and hashes as the run did, in any checkout."""
+    import os
+
+    if not case_file.exists():
+        return
+    data = tomllib.loads(case_file.read_text())
+    states = data.get("air", {}).get("bed_states")
+    if not states:
+        return
+    data["air"]["bed_states"] = [os.path.relpath(Path(s).resolve(), case_file.parent.resolve())
+                                 for s in states]
+    case_file.write_text(tomli_w.dumps(data))
 
 
 def measure(out: Path, at_s: float, until_s: float) -> dict[str, Any]:
@@ -194,6 +211,8 @@ def main(argv: list[str] | None = None) -> int:
                         help="the around_bed level's air.bed_states (this scene's states)")
     parser.add_argument("--mesh-size", type=float, default=None,
                         help="air.mesh_size of every level run here, m (default the case's)")
+    parser.add_argument("--suffix", default="", help="appended to the runs' and the table's names "
+                        "(e.g. _1phase: the same level with another set of bed states)")
     parser.add_argument("--note", default="", help="what else ran on the machine, for the record")
     args = parser.parse_args(argv)
     rows = []
@@ -205,7 +224,7 @@ def main(argv: list[str] | None = None) -> int:
             name = str(out.resolve().relative_to(ROOT)) if out.resolve().is_relative_to(ROOT) else out.name
         else:
             case = level_case(args.model, level, args.coarse_grain, args.time, args.runs / "cases",
-                              args.bed_states, args.mesh_size)
+                              args.bed_states, args.mesh_size, args.suffix)
             out = args.runs / case.stem
             run(case, out)
             # Measured from the shipped copy, so the table can be made again from the repository.
@@ -215,7 +234,7 @@ def main(argv: list[str] | None = None) -> int:
     table = pd.DataFrame(rows)
     args.out.mkdir(parents=True, exist_ok=True)
     mesh = "" if args.mesh_size is None else f"_mesh{args.mesh_size:g}"
-    stem = f"levels_model_{args.model}_cg{args.coarse_grain:g}{mesh}"
+    stem = f"levels_model_{args.model}_cg{args.coarse_grain:g}{mesh}{args.suffix}"
     table.to_csv(args.out / f"{stem}.csv", index=False, float_format="%.6g")
     (args.out / f"{stem}.json").write_text(json.dumps(
         {"machine": subprocess.run(["uname", "-a"], capture_output=True, text=True).stdout.strip(),

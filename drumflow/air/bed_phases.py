@@ -165,6 +165,13 @@ class BedPhase:
     time_s: float
     source: str
     measures: dict[str, Any]
+    #: This state's solve (the first also solved the empty drum every state starts from).
+    wall_time_s: float = math.nan
+
+    def record(self) -> dict[str, Any]:
+        """The entry of :data:`PHASES_RECORD` for this state."""
+        return {"path": str(self.path), "angle_rad": self.angle_rad, "time_s": self.time_s,
+                "source": self.source, "split": self.measures, "wall_time_s": self.wall_time_s}
 
 
 def solve_bed_phases(case: Case, states: list[BedSnapshot], workdir: Path, out: Path,
@@ -190,6 +197,7 @@ def solve_bed_phases(case: Case, states: list[BedSnapshot], workdir: Path, out: 
     empty = None
     phases: list[BedPhase] = []
     for k, state in enumerate(states):
+        phase_started = time.perf_counter()
         result = solve_bed_air(case, state, workdir / f"phase_{k}", runner, processes=processes,
                                timeout=timeout, axial="periodic", empty=empty)
         empty = result.empty_solution
@@ -197,11 +205,10 @@ def solve_bed_phases(case: Case, states: list[BedSnapshot], workdir: Path, out: 
         path = out / f"bed_phase_{k}.npz"
         AirField.from_solution(result.bed_solution, case).to_npz(path)
         phases.append(BedPhase(path, float(state.drum_angle_rad), float(state.time_s),
-                               state.source, result.as_dict()))
+                               state.source, result.as_dict(), time.perf_counter() - phase_started))
         if on_phase is not None:
             on_phase(k + 1, len(states))
-    record = {"states": [{"path": str(p.path), "angle_rad": p.angle_rad, "time_s": p.time_s,
-                          "source": p.source, "split": p.measures} for p in phases],
+    record = {"states": [p.record() for p in phases],
               "spacing_rad": lifter_spacing(case.lifters.count),
               "wall_time_s": time.perf_counter() - started}
     (out / PHASES_RECORD).write_text(json.dumps(record, indent=2, default=float) + "\n")

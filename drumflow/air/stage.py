@@ -20,6 +20,7 @@ the case's inlet temperature throughout (one-way coupling: the particles do not 
 from __future__ import annotations
 
 import json
+import math
 import os
 import shutil
 import time
@@ -190,15 +191,25 @@ def _run_cfd(case: Case, rundir: RunDir, runner: Runner, inputs: AirInputs) -> A
     return AirResult(source, summary)
 
 
-#: Version of the bed phases' solve and files; part of their cache key.
+#: Version of the bed phases' solve and fields (not of the cache's layout); part of the keys.
 BED_PHASES_VERSION = 1
+
+
+def bed_phase_cache(empty_key: str, state_content: str) -> Path:
+    """The cache folder of one bed state's air (``bed_phase.npz`` and its record), keyed by the
+    empty drum's air and the state file's content (its SHA-256), so that runs with any subset of
+    the same states (1, 2, 4 phases: the convergence question) solve each state once."""
+    from drumflow.rundir import hash_text
+
+    return air_cache_dir() / ("bed-" + hash_text(json.dumps(
+        {"air": empty_key, "state": state_content, "version": BED_PHASES_VERSION})))
 
 
 def _with_bed_phases(case: Case, rundir: RunDir, runner: Runner, inputs: AirInputs,
                      empty: AirResult) -> AirResult:
     """The air around the bed (``air.bed_states``): each state's air solved once, cached by the
-    empty drum's key and the states' contents, its field beside the empty drum's in the run
-    directory; the coupling loop gets them all (field kind ``phases``)."""
+    empty drum's key and the state's content (:func:`bed_phase_cache`), its field beside the
+    empty drum's in the run directory; the coupling loop gets them all (field kind ``phases``)."""
     import hashlib
 
     from drumflow.air.bed_phases import PHASES_RECORD, lifter_spacing, solve_bed_phases
@@ -208,12 +219,13 @@ def _with_bed_phases(case: Case, rundir: RunDir, runner: Runner, inputs: AirInpu
         raise ValueError(f"air.bed_states names {len(case.air.bed_states)} state(s), the stage "
                          f"was given {len(inputs.bed_states)} (drumflow.dem.state.load_bed_states)")
     contents = [hashlib.sha256(Path(p).read_bytes()).hexdigest() for p in case.air.bed_states]
+    caches = [bed_phase_cache(empty.source.key, c) for c in contents]
+    # The fields the loop gets, by the drum's air and the states' contents in order.
     key = hash_text(json.dumps({"air": empty.source.key, "states": contents,
                                 "version": BED_PHASES_VERSION}))
-    cache = air_cache_dir() / f"bed-{key}"
-    hit = (cache / PHASES_RECORD).exists()
+    missing = [k for k, c in enumerate(caches) if not (c / PHASES_RECORD).exists()]
     t0 = time.perf_counter()
-    if not hit:
+    if missing:
         work = rundir.air / "bed_openfoam"
         if work.exists():
             shutil.rmtree(work)
@@ -223,26 +235,39 @@ def _with_bed_phases(case: Case, rundir: RunDir, runner: Runner, inputs: AirInpu
             if progress:
                 progress("air around the bed", float(done), float(total))
 
-        on_phase(0, len(inputs.bed_states))
-        solve_bed_phases(case, list(inputs.bed_states), work, cache, runner,
-                         processes=inputs.processes, on_phase=on_phase)
-    record = read_json_object(cache / PHASES_RECORD,
-                              "the bed phases' cache record (delete its folder to solve again)")
+        on_phase(0, len(missing))
+        solved = solve_bed_phases(case, [inputs.bed_states[k] for k in missing], work,
+                                  work / "fields", runner, processes=inputs.processes,
+                                  on_phase=on_phase)
+        for k, phase in zip(missing, solved, strict=True):
+            caches[k].mkdir(parents=True, exist_ok=True)
+            shutil.copyfile(phase.path, caches[k] / "bed_phase.npz")
+            # The record last: its presence says the field beside it is whole.
+            (caches[k] / PHASES_RECORD).write_text(json.dumps(phase.record(), indent=2, default=float))
+        shutil.rmtree(work, ignore_errors=True)
+    what = "a bed state's cached air record (delete its folder to solve again)"
+    states = [read_json_object(c / PHASES_RECORD, what) for c in caches]
     paths = []
-    for k in range(len(case.air.bed_states)):
+    for k, cache in enumerate(caches):
         paths.append(rundir.air / f"bed_phase_{k}.npz")
-        shutil.copyfile(cache / f"bed_phase_{k}.npz", paths[-1])
-    (rundir.air / PHASES_RECORD).write_text(json.dumps(record, indent=2))
-    angles = [float(s["angle_rad"]) for s in record["states"]]
+        shutil.copyfile(cache / "bed_phase.npz", paths[-1])
+        states[k]["path"] = str(paths[-1])
+    solve_wall = sum(float(s.get("wall_time_s", math.nan)) for s in states)
+    (rundir.air / PHASES_RECORD).write_text(json.dumps(
+        {"states": states, "spacing_rad": lifter_spacing(case.lifters.count),
+         "wall_time_s": solve_wall}, indent=2))
+    angles = [float(s["angle_rad"]) for s in states]
     field_spec = {"kind": "phases", "paths": [str(p) for p in paths], "angles": angles,
                   "spacing": lifter_spacing(case.lifters.count), "omega": case.drum.omega}
     summary = empty.summary
     summary.extra["bed_phases"] = {
-        "states": [s["source"] for s in record["states"]],
+        "states": [s["source"] for s in states],
         "angles_rad": angles,
-        "time_s": [float(s["time_s"]) for s in record["states"]],
-        "cache_hit": hit,
-        "solve_wall_time_s": float(record["wall_time_s"]),
+        "time_s": [float(s["time_s"]) for s in states],
+        "cache_hit": not missing,
+        "solved_here": len(missing),
+        # What the states' solves took, here or in the run that cached them.
+        "solve_wall_time_s": solve_wall,
         "stage_wall_time_s": time.perf_counter() - t0,
     }
     return AirResult(FieldSource(field_spec, f"phases:{key}", case.drum.omega), summary)

@@ -78,6 +78,9 @@ def export(
                   f"t = {times[0]:.3g}-{times[-1]:.3g} s, {max(result.particles):,} particles")
     table.add_row("walls", f"{result.walls_pvd}: turned by the drum angle at each snapshot")
     table.add_row("air", result.air or "none (the run has no air)")
+    if result.air_bed_phases:
+        table.add_row("air around the bed", f"{', '.join(result.air_bed_phases)}: the fields the "
+                      "loop applied, one per bed state (air.vti is the empty drum's)")
     table.add_row("size", f"{result.bytes_written / 1e6:.2f} MB binary "
                   f"(text snapshots: {result.snapshot_text_bytes / 1e6:.2f} MB)")
     console.print(table)

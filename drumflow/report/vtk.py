@@ -15,13 +15,17 @@ Written into ``OUT`` (default ``RUN_DIR/vtk``):
   ``pressure`` (Pa) and ``fluid`` (1 inside the air volume). A CFD field is solved in the
   drum's rotating frame: the file holds it at t = 0, when drum and lab frame coincide (rotate it
   by ``omega t`` about z, ParaView's Transform filter, to lay it over a later snapshot).
+  A run with the air around the bed (``air.bed_states``) solved the empty drum (``air.vti``)
+  and one field per bed state: ``air_bed_phase_K.vti``, each with field data
+  ``phase_angle_rad`` (where the state's lifters stood in the lifter spacing) and the same
+  frame; those are the fields the coupling loop applied, the empty drum's is not.
 
 Library code: writes files and returns what it wrote; ``drumflow.cli.export`` prints.
 """
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 from xml.sax.saxutils import quoteattr
@@ -39,6 +43,7 @@ from drumflow.rundir import RunDir
 if TYPE_CHECKING:
     import pyvista as pv
 
+    from drumflow.air.field import AirField
     from drumflow.case import Case
 
 __all__ = ["VtkExport", "export_vtk"]
@@ -56,6 +61,7 @@ class VtkExport:
     particles: list[int]
     bytes_written: int
     snapshot_text_bytes: int
+    air_bed_phases: list[str] = field(default_factory=list)
 
     def as_dict(self) -> dict[str, Any]:
         return asdict(self)
@@ -104,18 +110,17 @@ def _walls(rundir: RunDir) -> tuple[pv.PolyData | None, pv.PolyData]:
 
 def _air_grid(rundir: RunDir, case: Case) -> pv.ImageData | None:
     """The air field as VTK image data (x fastest), or None without air."""
-    import pyvista as pv
 
     from drumflow.air.field import AirField
 
     if rundir.air_field.exists():
-        field = AirField.from_npz(rundir.air_field)
+        solved = AirField.from_npz(rundir.air_field)
     elif case.air.model == "uniform":
         # The grid and the air volume of plug flow, carrying the velocity the coupling loop
         # applied (its input file; the case's own value when the run never reached the loop).
         from drumflow.air.source import uniform_field
 
-        field = AirField.uniform(case)
+        solved = AirField.uniform(case)
         spec_file = rundir.dem / COUPLING_FILE
         spec: dict[str, Any] = {}
         if spec_file.exists():
@@ -126,21 +131,54 @@ def _air_grid(rundir: RunDir, case: Case) -> pv.ImageData | None:
                                    "the coupling loop applied)", what)
             spec = applied
         velocity = spec.get("velocity") or uniform_field(case).field["velocity"]
-        field.velocity[...] = np.asarray(velocity, dtype=float)
+        solved.velocity[...] = np.asarray(velocity, dtype=float)
     else:
         return None
-    nx, ny, nz = field.shape
-    grid = pv.ImageData(dimensions=(nx, ny, nz), spacing=tuple(field.spacing),
-                        origin=tuple(field.origin))
+    return _field_grid(solved, case)
+
+
+def _field_grid(air: AirField, case: Case) -> pv.ImageData:
+    """One air field as VTK image data (x fastest), in the drum frame at t = 0."""
+    import pyvista as pv
+
+    nx, ny, nz = air.shape
+    grid = pv.ImageData(dimensions=(nx, ny, nz), spacing=tuple(air.spacing),
+                        origin=tuple(air.origin))
 
     # AirField arrays are C-ordered (x, y, z); VTK points run x fastest (Fortran order).
     grid.point_data["velocity"] = np.column_stack(
-        [field.velocity[..., k].ravel(order="F") for k in range(3)])
-    grid.point_data["pressure"] = field.pressure.ravel(order="F")
-    grid.point_data["fluid"] = field.fluid.astype(np.uint8).ravel(order="F")
+        [air.velocity[..., k].ravel(order="F") for k in range(3)])
+    grid.point_data["pressure"] = air.pressure.ravel(order="F")
+    grid.point_data["fluid"] = air.fluid.astype(np.uint8).ravel(order="F")
     grid.field_data["frame"] = np.array(["drum frame at t = 0 (rotate by omega t about +z)"])
-    grid.field_data["model"] = np.array([str(field.meta.get("model", case.air.model))])
+    grid.field_data["model"] = np.array([str(air.meta.get("model", case.air.model))])
     return grid
+
+
+def _bed_phase_grids(rundir: RunDir, case: Case) -> list[pv.ImageData]:
+    """The air around the bed at each of the run's bed states (``air/bed_phase_K.npz``, where
+    its record ``air/bed_phases.json`` says each state's lifter angle); empty without."""
+    from drumflow.air.bed_phases import PHASES_RECORD
+    from drumflow.air.field import AirField
+
+    if not case.air.bed_states or not (rundir.air / PHASES_RECORD).exists():
+        return []
+    what = "the air stage's record of the bed phases"
+    record = read_json_object(rundir.air / PHASES_RECORD, what)
+    states = record.get("states")
+    if not isinstance(states, list) or len(states) != len(case.air.bed_states):
+        raise BadFileError(rundir.air / PHASES_RECORD, f"states = {states!r}: expected one entry per "
+                           f"air.bed_states ({len(case.air.bed_states)})", what)
+    grids = []
+    for k, state in enumerate(states):
+        path = rundir.air / f"bed_phase_{k}.npz"
+        if not path.exists():
+            raise RunDirectoryError(f"{path}: missing (the air stage writes one field per bed "
+                                    "state); rerun the case")
+        grid = _field_grid(AirField.from_npz(path), case)
+        grid.field_data["phase_angle_rad"] = np.array([float(state["angle_rad"])])
+        grids.append(grid)
+    return grids
 
 
 def export_vtk(run_dir: Path | str, out: Path | str | None = None) -> VtkExport:
@@ -214,7 +252,12 @@ def export_vtk(run_dir: Path | str, out: Path | str | None = None) -> VtkExport:
         air_name = "air.vti"
         grid.save(str(target / air_name), binary=True)
         written += (target / air_name).stat().st_size
+    phases = _bed_phase_grids(rundir, case)
+    for k, phase in enumerate(phases):
+        phase.save(str(target / f"air_bed_phase_{k}.vti"), binary=True)
+        written += (target / f"air_bed_phase_{k}.vti").stat().st_size
     return VtkExport(
+        air_bed_phases=[f"air_bed_phase_{k}.vti" for k in range(len(phases))],
         out=str(target),
         particles_pvd="particles.pvd",
         walls_pvd="walls.pvd",

@@ -57,3 +57,17 @@ def test_smoke_drum_with_the_air_around_its_bed(tmp_path: Path) -> None:
     u_empty = air_velocity_at(empty, x, state.time_s, case.drum.omega)
     slow, free = (float(np.abs(u[:, 2]).mean()) for u in (u_bed, u_empty))
     assert slow < 0.5 * free, (slow, free)
+
+    # What ParaView gets: the field the loop applied for each bed state beside the empty drum's
+    # (the empty drum's alone was exported before: a run with bed states showed air that it
+    # never applied).
+    import pyvista as pv
+
+    from drumflow.report.vtk import export_vtk
+
+    exported = export_vtk(tmp_path / "run", tmp_path / "vtk")
+    assert exported.air == "air.vti" and exported.air_bed_phases == ["air_bed_phase_0.vti"]
+    phase = pv.read(str(tmp_path / "vtk" / "air_bed_phase_0.vti"))
+    assert float(phase.field_data["phase_angle_rad"][0]) == pytest.approx(phases["angles_rad"][0])
+    assert np.allclose(phase.point_data["velocity"][:, 2],
+                       around.fields[0].velocity[..., 2].ravel(order="F"))

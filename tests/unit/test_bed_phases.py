@@ -5,6 +5,7 @@ against hand values and against fields whose symmetry gives the answer. No solve
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -169,3 +170,16 @@ def test_a_bed_state_of_another_scene_is_refused_by_its_field(tmp_path) -> None:
     with pytest.raises(StartStateError, match=r"air\.bed_states\[0\] = .*no such file"):
         load_bed_states(missing)
     assert len(load_bed_states(_with_states(tmp_path, [str(SMOKE_STATE)]))) == 1
+
+
+def test_each_bed_state_is_cached_alone(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A run with 1 of 4 states reuses that state's solve (the number of states is a convergence
+    question: asking it must not solve the same state again); another state or another empty
+    drum's air is another entry."""
+    from drumflow.air import stage
+
+    monkeypatch.setattr(stage, "air_cache_dir", lambda: tmp_path / "cache")
+    assert stage.bed_phase_cache("air1", "a") == stage.bed_phase_cache("air1", "a")
+    assert stage.bed_phase_cache("air1", "a") != stage.bed_phase_cache("air1", "b")
+    assert stage.bed_phase_cache("air1", "a") != stage.bed_phase_cache("air2", "a")
+    assert stage.bed_phase_cache("air1", "a").parent == tmp_path / "cache"
