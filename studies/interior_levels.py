@@ -80,7 +80,7 @@ def run(case: Path, out: Path) -> None:
 #: What is shipped of each run (small text files): enough to measure it again without the run.
 SHIPPED = ("case.toml", "summary.json", "post/mean_temperature.csv", "post/air_heat.csv",
            "post/crossings.csv", "post/methodology.json", "post/steps.csv", "post/mean_temperature.png",
-           "post/closures.json")
+           "post/closures.json", "air/bed_phases.json")
 
 
 def ship(out: Path, folder: Path) -> Path:

@@ -30,6 +30,7 @@ CG_LADDER = "results/bench/paper_model_two_ladder/ladder.csv"
 MEASURED = "results/bench/paper_model_two_ladder_measured/ladder.csv"
 PERIODIC = "docs/plant/paper_model_one_plant_periodic.json"
 AIR_CLOSURES = "docs/plant/paper_model_one_plant_air_closures.json"
+LEVELS = "results/paper/levels/levels_model_two_cg2_mesh0.1.csv"
 
 #: (text typed in the README with its number in brackets, file, key, format). The text without
 #: the brackets is searched as it stands in a sentence; the value read from the file, formatted,
@@ -102,6 +103,13 @@ TYPED: list[tuple[str, str, str, str]] = [
     ("cascading flow is\n  [5.8] % high", MEASURED, "old_defaults.error_steady_mass_flow", ".1%"),
     ("the reference at\n  [14.0] s within", MEASURED, "reference_rule.stop_time_s", ".1f"),
     ("within [0.08] % of its end", MEASURED, "reference_rule.error_steady_mass_flow", ".2%"),
+    ("falls from [4,389] W/(m³ K)", LEVELS, "level=lumped:volumetric_coefficient_lmtd_W_m3K", ",.0f"),
+    ("to [3,336] with heat", LEVELS, "level=shells:volumetric_coefficient_lmtd_W_m3K", ",.0f"),
+    ("[1,046] with air that warms", LEVELS, "level=shells_warming:volumetric_coefficient_lmtd_W_m3K",
+     ",.0f"),
+    ("and [82.3] with\n  the air around", LEVELS, "level=around_bed:volumetric_coefficient_lmtd_W_m3K",
+     ".1f"),
+    ("contact efficiency [0.079])", LEVELS, "level=around_bed:contact_efficiency", ".3f"),
 ]
 
 
@@ -130,6 +138,23 @@ def test_a_typed_readme_number_is_its_files(text: str, file: str, key: str, fmt:
 
 def _json(path: str) -> dict:
     return json.loads((ROOT / path).read_text())
+
+
+def test_the_levels_costs_and_states() -> None:
+    """'one state gives the answer of four within 0.03 %', 'costs 3.0 times one-way at these
+    parcels (the four states' porous solves, 1,253 s, and its DEM against one-way's whole run)': the 1-state table against the 4-state
+    row, the bed states' solve time from the runs' shipped air record against the lumped run."""
+    one = float(numbers.value("results/paper/levels/levels_model_two_cg2_mesh0.1_1phase.csv",
+                              "volumetric_coefficient_lmtd_W_m3K"))
+    four = float(numbers.value(LEVELS, "volumetric_coefficient_lmtd_W_m3K", row={"level": "around_bed"}))
+    assert f"{abs(one / four - 1):.2%}" == "0.03%"
+    runs = ROOT / "results" / "paper" / "levels" / "runs"
+    solve = sum(s["wall_time_s"] for s in _json(str(runs / "paper_model_two_around_bed_cg2_mesh0.1"
+                                                      / "air" / "bed_phases.json"))["states"])
+    assert f"{solve:,.0f}" == "1,253"
+    dem = _json(str(runs / "paper_model_two_around_bed_cg2_mesh0.1" / "summary.json"))["dem_wall_time_s"]
+    lumped = _json(str(runs / "paper_model_two_lumped_cg2_mesh0.1" / "summary.json"))["wall_time_s"]
+    assert f"{(solve + dem) / lumped:.1f}" == "3.0"
 
 
 def test_the_coarse_graining_cost_ratio() -> None:
