@@ -142,8 +142,9 @@ def _json(path: str) -> dict:
 
 def test_the_levels_costs_and_states() -> None:
     """'one state gives the answer of four within 0.03 %', 'costs 3.0 times one-way at these
-    parcels (the four states' porous solves, 1,253 s, and its DEM against one-way's whole run)': the 1-state table against the 4-state
-    row, the bed states' solve time from the runs' shipped air record against the lumped run."""
+    parcels (the four states' porous solves, 1,253 s, and its DEM against one-way's whole run)':
+    the 1-state table against the 4-state row, the bed states' solve time from the runs' shipped
+    air record against the lumped run."""
     one = float(numbers.value("results/paper/levels/levels_model_two_cg2_mesh0.1_1phase.csv",
                               "volumetric_coefficient_lmtd_W_m3K"))
     four = float(numbers.value(LEVELS, "volumetric_coefficient_lmtd_W_m3K", row={"level": "around_bed"}))
