@@ -145,6 +145,8 @@ class DemResult:
     log: str
     #: The 'converged' stop rule's verdict (``dem/coupling/stop.json``); None for a fixed run.
     stop: dict[str, Any] | None = None
+    #: True when this call found the stage finished and ran nothing.
+    reused: bool = False
 
 
 def _add_loop_options(spec_path: Path, case: Case, plan: StepPlan, checkpoint: str | None) -> None:
@@ -504,7 +506,7 @@ def run(case: Case, rundir: RunDir, runner: Runner, inputs: DemInputs) -> DemRes
     key = _stage_key(case, inputs)
     done = rundir.stage_done("dem", key)
     if done:
-        return DemResult(**done["result"])
+        return DemResult(**{**done["result"], "reused": True})
     state = load_start_state(case)
     first_step = None if state is None else start_step(state, inputs.plan.time_step)
     if state is not None and first_step is not None:

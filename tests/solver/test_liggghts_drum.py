@@ -111,8 +111,11 @@ def test_post_recomputes_without_solver(conduction_run: tuple[dict, Path]) -> No
     # Rerunning the same case reuses the finished DEM stage: no new LIGGGHTS command.
     case = load_case(out / "case.toml")
     n_commands = len(json.loads((out / "manifest.json").read_text())["commands"])
-    run_case(case, out)
+    again = run_case(case, out)
     assert len(json.loads((out / "manifest.json").read_text())["commands"]) == n_commands
+    # And keeps the run's own wall time (the reuse's seconds once overwrote it: session 52).
+    assert again["wall_time_s"] == summary["wall_time_s"]
+    assert 0 < again["reuse_wall_time_s"] < summary["wall_time_s"]
 
 
 @pytest.mark.timeout(400)
