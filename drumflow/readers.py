@@ -30,8 +30,10 @@ from drumflow.errors import BadFileError
 
 if TYPE_CHECKING:
     import pandas as pd
+    from pydantic import ValidationError
 
 __all__ = [
+    "field_problems",
     "output_file",
     "output_folder",
     "read_csv",
@@ -287,3 +289,23 @@ def output_file(path: Path | str, option: str = "--out") -> Path:
         raise BadFileError(p, f"an existing folder, not a file; allowed for {option}: a file "
                            "path (new, or an existing file to replace)")
     return p
+
+
+def field_problems(exc: ValidationError, data: dict[str, Any]) -> list[str]:
+    """One line per problem of a pydantic validation of ``data``: the field (its dotted path),
+    its value and what is allowed."""
+    lines = []
+    for err in exc.errors():
+        loc = err["loc"]
+        name = ".".join(str(part) for part in loc) or "(file)"
+        value: Any = data
+        for part in loc:  # down to the value itself (nested models, lists)
+            if isinstance(value, dict):
+                value = value.get(part)
+            elif isinstance(value, list) and isinstance(part, int) and part < len(value):
+                value = value[part]
+            else:
+                value = None
+        shown = "missing" if err["type"] == "missing" else f"= {value!r}"
+        lines.append(f"{name} {shown}: {err['msg']}")
+    return lines

@@ -31,7 +31,7 @@ from typing import Any
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
 from drumflow.errors import BadFileError
-from drumflow.readers import read_json_object
+from drumflow.readers import field_problems, read_json_object
 
 __all__ = ["MIXING_BOUNDS", "AirClosures", "read_air_closures"]
 
@@ -97,18 +97,13 @@ class AirClosures(BaseModel):
         return {name: value for name, value in found.items() if value is not None}
 
 
-def _problems(exc: ValidationError) -> str:
-    return "; ".join(f"{'.'.join(str(p) for p in err['loc'])} = {err.get('input')!r}: {err['msg']}"
-                     for err in exc.errors())
-
-
 def validate_air_closures(data: dict[str, Any], path: Path | str) -> AirClosures:
     """``data`` as :class:`AirClosures`, or a :class:`BadFileError` naming ``path`` and each
     field that is missing, not a number or out of its range."""
     try:
         return AirClosures.model_validate(data)
     except ValidationError as exc:
-        raise BadFileError(path, f"invalid air closures: {_problems(exc)}",
+        raise BadFileError(path, f"invalid air closures: {'; '.join(field_problems(exc, data))}",
                            "a slice's air closures") from None
 
 

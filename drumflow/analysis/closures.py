@@ -45,7 +45,7 @@ from drumflow.analysis.air_side import airborne_mask
 from drumflow.analysis.observables import falling_mass_flow
 from drumflow.case import Case, load_case
 from drumflow.errors import BadFileError, RunDirectoryError
-from drumflow.readers import read_csv, read_json_object
+from drumflow.readers import field_problems, read_csv, read_json_object
 from drumflow.rundir import RunDir
 
 __all__ = ["SliceClosures", "bed_surface_length", "extract_closures", "load_closures"]
@@ -218,25 +218,6 @@ class ClosuresFile(BaseModel):
         return value
 
 
-def _closure_problems(exc: ValidationError, data: dict[str, Any]) -> list[str]:
-    """One line per problem: the field, its value and what is allowed."""
-    lines = []
-    for err in exc.errors():
-        loc = err["loc"]
-        name = ".".join(str(part) for part in loc) or "(file)"
-        value: Any = data
-        for part in loc:  # down to the value itself (the air closures are nested)
-            if isinstance(value, dict):
-                value = value.get(part)
-            elif isinstance(value, list) and isinstance(part, int) and part < len(value):
-                value = value[part]
-            else:
-                value = None
-        shown = "missing" if err["type"] == "missing" else f"= {value!r}"
-        lines.append(f"{name} {shown}: {err['msg']}")
-    return lines
-
-
 def load_closures(path: Path | str) -> SliceClosures:
     """Read closures written by :meth:`SliceClosures.write`, validated by :class:`ClosuresFile`.
 
@@ -251,7 +232,7 @@ def load_closures(path: Path | str) -> SliceClosures:
     try:
         ClosuresFile.model_validate(data)
     except ValidationError as exc:
-        problems = _closure_problems(exc, data)
+        problems = field_problems(exc, data)
         raise BadFileError(p, "invalid closures:\n" + "\n".join(f"  - {line}" for line in problems),
                            "a closures file") from None
     return SliceClosures.from_dict(data)
@@ -441,7 +422,7 @@ def extract_closures(run_dir: Path | str, start_s: float | None = None) -> Slice
     try:
         ClosuresFile.model_validate(data)
     except ValidationError as exc:
-        lines = "\n".join(f"  - {line}" for line in _closure_problems(exc, data))
+        lines = "\n".join(f"  - {line}" for line in field_problems(exc, data))
         raise RunDirectoryError(
             f"{run.dem_dumps}: the closures of its {len(times)} snapshot(s) after {start:g} s are "
             f"not usable (a NaN: no airborne particle in any of them?):\n{lines}") from None
