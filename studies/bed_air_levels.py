@@ -13,6 +13,10 @@ efficiency, the saturated (through-curtain) air per metre, and the slice's volum
 coefficient two ways, as ``studies/interior_levels.py`` defines them: Q / (V (T_p - T_in)) and
 Q / (V LMTD) with the air in at T_in and out at the slice's outlet (V = pi D^2 L / 4). A bed-air
 slice is one frozen state (5 s), not a coupled run: no T(3.5 s) or h columns.
+
+Also OUT/frozen_against_loop.json and .csv: model two's slice with the coupled loop's choices
+switched on one at a time (:data:`SWITCHES`, ``--flux``, ``--film``, ``--mixing`` of
+``drumflow bed-air``), from the heat files of :data:`SWITCHES_DIR` that exist.
 """
 
 from __future__ import annotations
@@ -25,6 +29,8 @@ from pathlib import Path
 from typing import Any
 
 import pandas as pd
+
+from drumflow.air.bed_heat import heat_file_name
 
 ROOT = Path(__file__).resolve().parents[1]
 AIR = ROOT / "results" / "air"
@@ -40,6 +46,19 @@ SLICES: dict[str, tuple[Path, dict[str, Path]]] = {
         {"local": AIR / "bed_air_model_two_5.0s_mesh0.1_periodic" / "heat.json",
          "turbulent": AIR / "bed_air_model_two_5.0s_mesh0.1_periodic" / "heat_turbulent.json",
          "molecular": AIR / "bed_air_model_two_5.0s_mesh0.1_periodic_molecular" / "heat.json"}),
+}
+#: The frozen analysis against the coupled loop's choices (issue 32), each switched on model
+#: two's 5 s state, 0.1 m mesh, periodic (one flow, ``drumflow bed-air --heat-only`` per row):
+#: label -> (mixing, flux, film, heat file).
+SWITCHES_DIR = AIR / "bed_air_model_two_5.0s_mesh0.1_periodic_switches"
+SWITCHES: dict[str, tuple[str, str, str]] = {
+    "the analysis (default)": ("local", "relative", "gunn"),
+    "lab-frame flux": ("local", "absolute", "gunn"),
+    "lab-frame flux + the bed's carried air": ("local", "carried", "gunn"),
+    "Ranz-Marshall film": ("local", "relative", "ranz_marshall"),
+    "molecular mixing": ("molecular", "relative", "gunn"),
+    "the loop's three (lab flux, molecular, Ranz-Marshall)": ("molecular", "absolute",
+                                                             "ranz_marshall"),
 }
 #: The plant's measured volumetric coefficient (issue 34), as in studies/interior_levels.py.
 PLANT_UA = 290.0
@@ -79,8 +98,18 @@ def main() -> None:
     args.out.mkdir(parents=True, exist_ok=True)
     (args.out / "levels_air_around_the_bed.json").write_text(json.dumps(rows, indent=2) + "\n")
     pd.DataFrame(rows).to_csv(args.out / "levels_air_around_the_bed.csv", index=False)
+    switches = []
+    for label, (mixing, flux, film) in SWITCHES.items():
+        heat_file = SWITCHES_DIR / heat_file_name(mixing, flux, film)
+        if heat_file.is_file():  # rows not yet solved are left out, never guessed
+            switches.append({"switch": label, "flux": flux, "film": film,
+                             **row("model_two_5.0s_mesh0.1_periodic", mixing,
+                                   SLICES["model_two_5.0s_mesh0.1_periodic"][0], heat_file)})
+    (args.out / "frozen_against_loop.json").write_text(json.dumps(switches, indent=2) + "\n")
+    pd.DataFrame(switches).to_csv(args.out / "frozen_against_loop.csv", index=False)
+    rows += switches
     for r in rows:
-        print(f"{r['slice']:34s} {r['mixing']:9s} {r['heat_W'] / 1e3:7.1f} kW  eff "
+        print(f"{r.get('switch', r['slice']):34.34s} {r['mixing']:9s} {r['heat_W'] / 1e3:7.1f} kW  eff "
               f"{r['contact_efficiency']:.3f}  sat {r['saturated_flow_m3_s_m']:.3g}  Ua "
               f"{r['volumetric_coefficient_W_m3K']:,.0f} "
               f"(LMTD {r['volumetric_coefficient_lmtd_W_m3K']:,.0f})")

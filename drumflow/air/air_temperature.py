@@ -126,10 +126,12 @@ def _decouple(heat_dir: Path) -> None:
 def solve_air_temperature(bed_dir: Path, time_dir: str, heat_dir: Path, zones: HeatZones,
                           diffusivity: float | NDArray[np.float64], runner: Runner,
                           timeout: float | None = 3600.0, residual: float = 1e-6,
-                          ) -> AirTemperature:
+                          internal_flux: NDArray[np.float64] | None = None) -> AirTemperature:
     """Copy the solved case ``bed_dir``/``time_dir`` to ``heat_dir``, write and run the
     temperature case (module docstring), and read theta, the outlet and the bookkeeping.
-    ``diffusivity``: D, m^2/s, one value or one per cell.
+    ``diffusivity``: D, m^2/s, one value or one per cell. ``internal_flux``: the internal
+    faces' flux to carry theta with instead of the solved ``phi``'s
+    (:func:`drumflow.air.transport_flux.transport_flux`; the boundary's are kept).
 
     Raises
     ------
@@ -163,6 +165,13 @@ def solve_air_temperature(bed_dir: Path, time_dir: str, heat_dir: Path, zones: H
     cells = read_cell_fields(bed_dir, time_dir)
     phi = FoamFieldFile(heat_dir / "0" / "phi")
     flux = np.asarray(phi.internal_field, float)
+    if internal_flux is not None:
+        given_flux = np.asarray(internal_flux, float)
+        if given_flux.shape != flux.shape or not np.all(np.isfinite(given_flux)):
+            raise AnalysisInputError("internal_flux", f"{given_flux.shape} values",
+                                     f"{flux.shape[0]} finite internal-face fluxes")
+        phi.internal_field = given_flux
+        flux = given_flux
     pb = cast(dict[str, Any], phi.boundary_field)
     alpha = _relaxation(mesh, flux, cells["C"], cells["V"], zones, d_cell)
     ends = {p: _end_faces(mesh, p, cells["C"], pb) for p in ("inlet", "outlet")}

@@ -46,8 +46,21 @@ before any comparison with the plant):
 - ``"molecular"``: nu / Pr everywhere, the lower bound (heat leaves the bed only with the air
   through it, and the curtains mix only by the mean flow).
 
-Not in any of them: the air the rolling bed carries in its voids (eps v_p, not in phi), and the
-bed's own particle mixing (the DEM moves the particles; the snapshot is frozen).
+Not in any of them: the bed's own particle mixing (the DEM moves the particles; the snapshot is
+frozen). The air the rolling bed carries in its voids (eps v_p, not in phi) is the ``flux``
+choice ``"carried"``.
+
+Two switches measure the frozen analysis against the coupled loop's choices on the same flow
+(added 2026-11-29; the defaults stay the analysis' own, so the shipped files are unchanged):
+
+- ``flux`` (:data:`~drumflow.air.transport_flux.FLUX`): ``"relative"`` (default) carries theta
+  with MRF's ``phi``, relative to the drum; ``"absolute"`` with the lab frame's flux, as the loop
+  does; ``"carried"`` adds the bed's air moving with its particles
+  (:mod:`drumflow.air.transport_flux` has the reasons).
+- ``film`` (:data:`FILM`): ``"gunn"`` (default) as above; ``"ranz_marshall"``, the loop's law:
+  Nu = 2 + 0.6 Re^0.5 Pr^(1/3) at Re of |U - v_p| (the solved superficial U less the cell's
+  particle mean, as the loop samples U at each particle) and the granule's diameter
+  (:func:`drumflow.physics.particle_air.ranz_marshall_h`).
 """
 
 from __future__ import annotations
@@ -77,10 +90,10 @@ if TYPE_CHECKING:
     from drumflow.physics.particle_air import AirState
     from drumflow.runner import Runner
 
-__all__ = ["BED_DISPERSION", "MIXING", "TURBULENT_PRANDTL", "AirTemperature", "BedHeatResult",
+__all__ = ["BED_DISPERSION", "FILM", "MIXING", "TURBULENT_PRANDTL", "AirTemperature", "BedHeatResult",
            "HeatSnapshot", "HeatZones", "bin_heat_sources", "cell_diffusivity", "exchange_rate",
            "measure_heat", "particle_means", "solve_air_temperature", "solve_bed_heat",
-           "superficial_slip", "turbulent_diffusivity"]
+           "heat_file_name", "superficial_slip", "turbulent_diffusivity"]
 
 #: Turbulent Prandtl number of air for the diffusivity.
 TURBULENT_PRANDTL = 0.85
@@ -88,6 +101,8 @@ TURBULENT_PRANDTL = 0.85
 K_BINS, T_BINS = 24, 6
 #: The diffusivity's choices (module notes): local (default), turbulent, molecular.
 MIXING = ("local", "turbulent", "molecular")
+#: The film law's choices (module notes): Gunn at the voidage (default), the loop's Ranz-Marshall.
+FILM = ("gunn", "ranz_marshall")
 #: A packed bed's transverse dispersion, D = 0.1 |u_s| d (Yagi & Kunii 1957; module notes).
 BED_DISPERSION = 0.1
 
@@ -96,6 +111,14 @@ def _finite(name: str, values: NDArray[np.float64], allowed: str = "finite numbe
     bad = ~np.isfinite(values)
     if np.any(bad):
         raise AnalysisInputError(name, np.asarray(values)[bad].ravel()[0], allowed)
+
+
+def heat_file_name(mixing: str = "local", flux: str = "relative", film: str = "gunn") -> str:
+    """``heat.json`` for the defaults; else ``heat_`` and the choices that differ from them,
+    e.g. ``heat_molecular.json``, ``heat_molecular_absolute_ranz_marshall.json``."""
+    parts = [c for c, default in ((mixing, "local"), (flux, "relative"), (film, "gunn"))
+             if c != default]
+    return "heat.json" if not parts else "heat_" + "_".join(parts) + ".json"
 
 
 def particle_means(centres: NDArray[np.float64], positions: NDArray[np.float64],
@@ -149,11 +172,16 @@ def superficial_slip(fraction: NDArray[np.float64], air_velocity: NDArray[np.flo
 
 def exchange_rate(fraction: NDArray[np.float64], air_velocity: NDArray[np.float64],
                   particle_velocity: NDArray[np.float64], diameter: float, air: AirState,
-                  heat_capacity: float) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Per cell h (W/(m^2 K), Gunn) and k = h a_v / (rho c_p) (1/s), a_v = 6 phi / d; zero in
-    cells with less than :data:`~drumflow.air.bed_air.POROUS_FRACTION` solids. ``air_velocity``
-    is the superficial (solved) one; see the module docstring for the slip."""
-    from drumflow.physics.particle_air import GUNN_VOIDAGE, gunn_h
+                  heat_capacity: float, film: str = "gunn",
+                  ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Per cell h (W/(m^2 K), Gunn, or Ranz-Marshall with ``film="ranz_marshall"``) and k = h
+    a_v / (rho c_p) (1/s), a_v = 6 phi / d; zero in cells with less than
+    :data:`~drumflow.air.bed_air.POROUS_FRACTION` solids. ``air_velocity`` is the superficial
+    (solved) one; see the module docstring for the slip."""
+    from drumflow.physics.particle_air import GUNN_VOIDAGE, gunn_h, ranz_marshall_h
+
+    if film not in FILM:
+        raise AnalysisInputError("film", film, " or ".join(FILM))
 
     if not (diameter > 0.0 and math.isfinite(diameter)):
         raise AnalysisInputError("diameter", diameter, "a finite length > 0 (m)")
@@ -166,8 +194,10 @@ def exchange_rate(fraction: NDArray[np.float64], air_velocity: NDArray[np.float6
     for name, a in (("air_velocity", U), ("particle_velocity", vp)):
         _finite(name, a)
     eps = 1.0 - phi
-    slip = superficial_slip(phi, U, vp)
-    h = gunn_h(slip, np.clip(eps, *GUNN_VOIDAGE), diameter, air)
+    if film == "gunn":
+        h = gunn_h(superficial_slip(phi, U, vp), np.clip(eps, *GUNN_VOIDAGE), diameter, air)
+    else:
+        h = ranz_marshall_h(np.linalg.norm(U - vp, axis=1), diameter, air)
     return h, np.where(phi >= POROUS_FRACTION,
                        h * 6.0 * phi / diameter / (air.density * heat_capacity), 0.0)
 
@@ -262,6 +292,9 @@ class BedHeatResult:
         heat_W, heat_bulk_W and contact_efficiency of the bed, curtain and free-air cells.
     mixing, diffusivity_m2_s, diffusivity_by_category_m2_s
         One of :data:`MIXING`; D's volume mean, and over the bed, curtain and free-air cells.
+    flux, film
+        The transport flux (:data:`~drumflow.air.transport_flux.FLUX`) and the film law
+        (:data:`FILM`) the heat was solved with.
     zones, binning_error, voidage_clipped_cells
         Source zones; heat with each cell's own k and T_p at the
         solved T over heat_W, less 1; source cells whose voidage was raised to Gunn's 0.35.
@@ -290,6 +323,8 @@ class BedHeatResult:
     iterations: int
     wall_time_s: float
     fields: dict[str, NDArray[np.float64]] = field(repr=False, default_factory=dict)
+    flux: str = "relative"
+    film: str = "gunn"
 
     def as_dict(self) -> dict[str, Any]:
         return {k: v for k, v in asdict(self).items() if k != "fields"}
@@ -329,7 +364,8 @@ class HeatSnapshot(BedSnapshot, Protocol):
 def solve_bed_heat(result: BedAirResult | None, state: HeatSnapshot, case: Case, runner: Runner,
                    workdir: Path, *, spacing: float | None = None,
                    timeout: float | None = 3600.0, k_bins: int = K_BINS, t_bins: int = T_BINS,
-                   residual: float = 1e-6, mixing: str = "local") -> BedHeatResult:
+                   residual: float = 1e-6, mixing: str = "local", flux: str = "relative",
+                   film: str = "gunn") -> BedHeatResult:
     """The heat the air takes from ``state``'s particles in the bed case that
     :func:`~drumflow.air.bed_air.solve_bed_air` solved (``result``) in ``workdir``
     (``workdir/bed``); the temperature case goes to ``workdir/heat``. ``result=None`` reuses
@@ -339,26 +375,30 @@ def solve_bed_heat(result: BedAirResult | None, state: HeatSnapshot, case: Case,
     ``split.json`` it wrote). ``spacing``: the
     deposition grid's, as given to :func:`~drumflow.air.bed_air.solve_bed_air` (default
     alike); ``k_bins``, ``t_bins``: :func:`bin_heat_sources`; ``residual``: the outer
-    iterations' target (:func:`solve_air_temperature`); ``mixing``: one of :data:`MIXING`.
+    iterations' target (:func:`solve_air_temperature`); ``mixing``: one of :data:`MIXING`;
+    ``flux``: one of :data:`~drumflow.air.transport_flux.FLUX`; ``film``: one of :data:`FILM`.
 
     Raises
     ------
     drumflow.errors.AnalysisInputError
         A NaN particle temperature or velocity, a bad diameter or solids fraction, mixing,
-        or (``result=None``) no converged bed case in ``workdir``.
+        flux or film, or (``result=None``) no converged bed case in ``workdir``.
     drumflow.errors.SolverError
         topoSet or scalarTransportFoam failed.
     """
     from drumflow.air.foam_case import air_properties_for
     from drumflow.air.foam_results import latest_time, read_cell_fields
     from drumflow.air.poly_mesh import read_poly_mesh
+    from drumflow.air.transport_flux import FLUX, transport_flux
     from drumflow.geometry.fluid import fluid_mesh_size
     from drumflow.physics.air import specific_heat
     from drumflow.physics.drum_frame import rotate_to_drum_frame
     from drumflow.physics.particle_air import GUNN_VOIDAGE, AirState
 
-    if mixing not in MIXING:
-        raise AnalysisInputError("mixing", mixing, " or ".join(MIXING))
+    for name, choice, allowed in (("mixing", mixing, MIXING), ("flux", flux, FLUX),
+                                  ("film", film, FILM)):
+        if choice not in allowed:
+            raise AnalysisInputError(name, choice, " or ".join(allowed))
     t0 = time.perf_counter()
     temps = np.asarray(state.temperatures_C, float)
     _finite("temperatures_C", temps)
@@ -387,7 +427,7 @@ def solve_bed_heat(result: BedAirResult | None, state: HeatSnapshot, case: Case,
     else:
         fraction = result.fields["fraction"]
     diameter = case.particles.diameter
-    _, k = exchange_rate(fraction, cells["U"], means[:, :3], diameter, air, cp)
+    _, k = exchange_rate(fraction, cells["U"], means[:, :3], diameter, air, cp, film)
     zones = bin_heat_sources(k, means[:, 3] - t_in, cells["V"], k_bins, t_bins)
     n = len(cells["V"])
     if mixing == "local":
@@ -401,8 +441,16 @@ def solve_bed_heat(result: BedAirResult | None, state: HeatSnapshot, case: Case,
     category = categorize(fraction)
     d_split = {c: float(np.average(diffusivity[category == i], weights=cells["V"][category == i]))
                for i, c in enumerate(CATEGORIES) if np.any(category == i)}
+    internal = None
+    if flux != "relative":
+        from foamlib import FoamFieldFile
+
+        solved_phi = np.asarray(FoamFieldFile(bed_dir / time_dir / "phi").internal_field, float)
+        carried = np.where((category == 0)[:, None], (1.0 - fraction)[:, None] * means[:, :3],
+                           0.0)
+        internal = transport_flux(mesh, solved_phi, case.drum.omega, flux, carried)
     solved = solve_air_temperature(bed_dir, time_dir, Path(workdir) / "heat", zones,
-                                   diffusivity, runner, timeout, residual)
+                                   diffusivity, runner, timeout, residual, internal)
     heat, bulk, split, binning = measure_heat(zones, solved, cells["V"], fraction, rho * cp)
     volume = 4.0 / 3.0 * math.pi * np.asarray(state.radii, float) ** 3
     tp_mean = float(np.average(temps, weights=volume))
@@ -417,7 +465,7 @@ def solve_bed_heat(result: BedAirResult | None, state: HeatSnapshot, case: Case,
         particle_mean_temperature_C=tp_mean,
         enthalpy_balance=advected / heat - 1.0 if heat else math.nan,
         other_out_W=rho * cp * solved.other_out_m3K_s,
-        by_category=split, mixing=mixing,
+        by_category=split, mixing=mixing, flux=flux, film=film,
         diffusivity_m2_s=float(np.average(diffusivity, weights=cells["V"])),
         diffusivity_by_category_m2_s=d_split, zones=len(zones.cells),
         binning_error=binning,

@@ -5,8 +5,8 @@ with the particles' heat, and the contact efficiency (:mod:`drumflow.air.bed_hea
 
 Exit codes (:func:`drumflow.errors.exit_code`): 0 written, 1 OpenFOAM failed or did not
 converge, 2 bad input (case file, a state of another scene, a grid spacing out of range, an
-unknown ``--axial`` or ``--mixing``, ``--heat-only`` without a matching earlier run), 130
-interrupted. Bad input is refused before any solver starts.
+unknown ``--axial``, ``--mixing``, ``--flux`` or ``--film``, ``--heat-only`` without a matching
+earlier run), 130 interrupted. Bad input is refused before any solver starts.
 """
 
 from __future__ import annotations
@@ -55,6 +55,13 @@ def bed_air(
                                         "turbulent (the mean nu_t everywhere, an upper bound for "
                                         "the bed's heat) or molecular (the lower bound)")
                       ] = "local",
+    flux: Annotated[str, typer.Option("--flux", help="the flux the heat is carried with: "
+                                      "relative (MRF's, to the drum), absolute (the lab's, as "
+                                      "the coupled loop) or carried (absolute plus the air the "
+                                      "bed's particles carry)")] = "relative",
+    film: Annotated[str, typer.Option("--film", help="the particles' film law: gunn (at the "
+                                      "cell's voidage) or ranz_marshall (the coupled loop's)")
+                    ] = "gunn",
     heat_only: Annotated[bool, typer.Option("--heat-only", help="only the air's temperature "
                                             "(implies --heat), on the flow an earlier run solved "
                                             "in the work folder for this state; its split.json in "
@@ -72,7 +79,7 @@ def bed_air(
     case = load_case_file(case_file)
     state = read_state(state_file)
     check_state(state, case, state_file)
-    _check_options(case, case_file, grid_spacing, processes, axial, mixing)
+    _check_options(case, case_file, grid_spacing, processes, axial, mixing, flux, film)
     workdir = work or DEFAULT_WORK / out.resolve().name
     result: BedAirResult | None = None
     paths: list[Path] = []
@@ -85,14 +92,14 @@ def bed_air(
         paths = list(write_bed_air(result, out))
         _print_split(result, case.name, axial)
     if heat or heat_only:
-        from drumflow.air.bed_heat import solve_bed_heat
+        from drumflow.air.bed_heat import heat_file_name, solve_bed_heat
 
         err_console.print("solving the air's temperature with the particles' heat ...",
                           highlight=False)
         warm = solve_bed_heat(result, state, case, Runner(), workdir, spacing=grid_spacing,
-                              mixing=mixing)
-        # One file per mixing, so the bounds sit beside the default.
-        paths.append(out / ("heat.json" if mixing == "local" else f"heat_{mixing}.json"))
+                              mixing=mixing, flux=flux, film=film)
+        # One file per choice, so the bounds and the loop's choices sit beside the default.
+        paths.append(out / heat_file_name(mixing, flux, film))
         paths[-1].write_text(json.dumps(warm.as_dict(), indent=2, default=float) + "\n")
         console.print(
             f"heat taken by the air {warm.heat_W / 1e3:.4g} kW of {warm.heat_bulk_W / 1e3:.4g} kW "
@@ -103,10 +110,12 @@ def bed_air(
 
 
 def _check_options(case: Case, case_file: Path, grid_spacing: float | None, processes: int,
-                   axial: str, mixing: str) -> None:
+                   axial: str, mixing: str, flux: str = "relative", film: str = "gunn"
+                   ) -> None:
     """Refuse, by name, what no solver should start with."""
     from drumflow.air.bed_air import AXIAL_MODES
-    from drumflow.air.bed_heat import MIXING
+    from drumflow.air.bed_heat import FILM, MIXING
+    from drumflow.air.transport_flux import FLUX
     from drumflow.errors import AnalysisInputError
     from drumflow.geometry.fluid import fluid_mesh_size
 
@@ -123,8 +132,10 @@ def _check_options(case: Case, case_file: Path, grid_spacing: float | None, proc
         raise AnalysisInputError("--processes", processes, "an integer from 1 to 256")
     if axial not in AXIAL_MODES:
         raise AnalysisInputError("--axial", axial, " or ".join(AXIAL_MODES))
-    if mixing not in MIXING:
-        raise AnalysisInputError("--mixing", mixing, " or ".join(MIXING))
+    for name, choice, allowed in (("--mixing", mixing, MIXING), ("--flux", flux, FLUX),
+                                  ("--film", film, FILM)):
+        if choice not in allowed:
+            raise AnalysisInputError(name, choice, " or ".join(allowed))
 
 
 def _check_reuse(split_file: Path, case_name: str, state: BedSnapshot, axial: str) -> None:
