@@ -110,6 +110,10 @@ TYPED: list[tuple[str, str, str, str]] = [
     ("and [82.3] with\n  the air around", LEVELS, "level=around_bed:volumetric_coefficient_lmtd_W_m3K",
      ".1f"),
     ("contact efficiency [0.079])", LEVELS, "level=around_bed:contact_efficiency", ".3f"),
+    ("one state: [431] W/(m³ K)", "results/paper/levels/levels_model_one_cg2_1phase.csv",
+     "level=around_bed:volumetric_coefficient_lmtd_W_m3K", ",.0f"),
+    ("([8,880] s on this VM", "results/paper/levels/runs/paper_model_one_around_bed_cg2_1phase/"
+     "summary.json", "wall_time_s", ",.0f"),
 ]
 
 
@@ -138,6 +142,14 @@ def test_a_typed_readme_number_is_its_files(text: str, file: str, key: str, fmt:
 
 def _json(path: str) -> dict:
     return json.loads((ROOT / path).read_text())
+
+
+def test_model_one_around_the_bed_against_the_plant() -> None:
+    """'431 W/(m³ K), 1.49 times the plant's': the run's coefficient over the table's plant."""
+    table = "results/paper/levels/levels_model_one_cg2_1phase.csv"
+    ua = float(numbers.value(table, "volumetric_coefficient_lmtd_W_m3K"))
+    plant = float(numbers.value(table, "plant_volumetric_coefficient_W_m3K"))
+    assert f"{ua / plant:.2f} times the plant's" in README.replace("\n  ", " ")
 
 
 def test_the_levels_costs_and_states() -> None:
