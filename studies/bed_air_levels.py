@@ -49,7 +49,7 @@ SLICES: dict[str, tuple[Path, dict[str, Path]]] = {
 }
 #: The frozen analysis against the coupled loop's choices (issue 32), each switched on model
 #: two's 5 s state, 0.1 m mesh, periodic (one flow, ``drumflow bed-air --heat-only`` per row):
-#: label -> (mixing, flux, film, heat file).
+#: label -> (mixing, flux, film); the heat file is heat_file_name's.
 SWITCHES_DIR = AIR / "bed_air_model_two_5.0s_mesh0.1_periodic_switches"
 SWITCHES: dict[str, tuple[str, str, str]] = {
     "the analysis (default)": ("local", "relative", "gunn"),

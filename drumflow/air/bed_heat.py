@@ -93,7 +93,7 @@ if TYPE_CHECKING:
 __all__ = ["BED_DISPERSION", "FILM", "MIXING", "TURBULENT_PRANDTL", "AirTemperature", "BedHeatResult",
            "HeatSnapshot", "HeatZones", "bin_heat_sources", "cell_diffusivity", "exchange_rate",
            "measure_heat", "particle_means", "solve_air_temperature", "solve_bed_heat",
-           "heat_file_name", "superficial_slip", "turbulent_diffusivity"]
+           "check_choices", "heat_file_name", "superficial_slip", "turbulent_diffusivity"]
 
 #: Turbulent Prandtl number of air for the diffusivity.
 TURBULENT_PRANDTL = 0.85
@@ -119,6 +119,17 @@ def heat_file_name(mixing: str = "local", flux: str = "relative", film: str = "g
     parts = [c for c, default in ((mixing, "local"), (flux, "relative"), (film, "gunn"))
              if c != default]
     return "heat.json" if not parts else "heat_" + "_".join(parts) + ".json"
+
+
+def check_choices(mixing: str, flux: str, film: str, prefix: str = "") -> None:
+    """Refuse, by name (``prefix`` + mixing, flux or film), a choice not in :data:`MIXING`,
+    :data:`~drumflow.air.transport_flux.FLUX` or :data:`FILM`."""
+    from drumflow.air.transport_flux import FLUX
+
+    for name, choice, allowed in (("mixing", mixing, MIXING), ("flux", flux, FLUX),
+                                  ("film", film, FILM)):
+        if choice not in allowed:
+            raise AnalysisInputError(prefix + name, choice, " or ".join(allowed))
 
 
 def particle_means(centres: NDArray[np.float64], positions: NDArray[np.float64],
@@ -389,16 +400,13 @@ def solve_bed_heat(result: BedAirResult | None, state: HeatSnapshot, case: Case,
     from drumflow.air.foam_case import air_properties_for
     from drumflow.air.foam_results import latest_time, read_cell_fields
     from drumflow.air.poly_mesh import read_poly_mesh
-    from drumflow.air.transport_flux import FLUX, transport_flux
+    from drumflow.air.transport_flux import transport_flux
     from drumflow.geometry.fluid import fluid_mesh_size
     from drumflow.physics.air import specific_heat
     from drumflow.physics.drum_frame import rotate_to_drum_frame
     from drumflow.physics.particle_air import GUNN_VOIDAGE, AirState
 
-    for name, choice, allowed in (("mixing", mixing, MIXING), ("flux", flux, FLUX),
-                                  ("film", film, FILM)):
-        if choice not in allowed:
-            raise AnalysisInputError(name, choice, " or ".join(allowed))
+    check_choices(mixing, flux, film)
     t0 = time.perf_counter()
     temps = np.asarray(state.temperatures_C, float)
     _finite("temperatures_C", temps)

@@ -114,8 +114,7 @@ def _check_options(case: Case, case_file: Path, grid_spacing: float | None, proc
                    ) -> None:
     """Refuse, by name, what no solver should start with."""
     from drumflow.air.bed_air import AXIAL_MODES
-    from drumflow.air.bed_heat import FILM, MIXING
-    from drumflow.air.transport_flux import FLUX
+    from drumflow.air.bed_heat import check_choices
     from drumflow.errors import AnalysisInputError
     from drumflow.geometry.fluid import fluid_mesh_size
 
@@ -132,10 +131,7 @@ def _check_options(case: Case, case_file: Path, grid_spacing: float | None, proc
         raise AnalysisInputError("--processes", processes, "an integer from 1 to 256")
     if axial not in AXIAL_MODES:
         raise AnalysisInputError("--axial", axial, " or ".join(AXIAL_MODES))
-    for name, choice, allowed in (("--mixing", mixing, MIXING), ("--flux", flux, FLUX),
-                                  ("--film", film, FILM)):
-        if choice not in allowed:
-            raise AnalysisInputError(name, choice, " or ".join(allowed))
+    check_choices(mixing, flux, film, prefix="--")
 
 
 def _check_reuse(split_file: Path, case_name: str, state: BedSnapshot, axial: str) -> None:
