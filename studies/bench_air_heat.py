@@ -17,11 +17,25 @@ A-B-A-B (three rounds of a sequence of updates each), on:
   moving 7.5 mm across the section per update (the shell's speed at 1.5 m, 0.01 s).
 
 The particles are synthetic (placed, not simulated): the systems have the real grids and flows
-and the parcels' film conductances, which is what the solver's cost depends on. Writes OUT.json
-(per arm and grid: median and range of the wall time per update, iterations per solve, the
-largest difference between the arms' fields) and prints it.
+and the parcels' film conductances, which is what the solver's cost depends on.
 
-Usage: .venv/bin/python studies/bench_air_heat.py OUT.json [--field PATH --spacing M]
+``--replay RUN`` adds a run's own air and particles (a run of air around the bed, whose grid is a
+few cells long along the axis and whose bed the air goes around): the particles of its snapshots
+(``dem/dumps/snap.*.npz``) with the loop's film (Ranz-Marshall at the slip to the run's air),
+each snapshot followed by UPDATES updates in which the particles move on at their own velocity
+(``interval`` steps of the run per update; their temperatures, which move by 0.1 % of their
+excess per update, are held). The bookkeeping's
+source is the heat the shells gave in the run, which is not the film's at the implicit solve's
+air (the interior advances over the interval): it stands in here as the film's heat times a
+factor drawn per particle in [0.95, 1.05] (a few per cent, as between the loop's two solves).
+The arms: "one switch" (2026-11-29 to 11-30: a failure of the lines on either system moved both
+to the incomplete LU for the rest of the run) against "per system" (now: each system keeps its
+own), each from a fresh solver per snapshot.
+
+Writes OUT.json (per arm and grid: median and range of the wall time per update, iterations per
+update, the largest difference between the arms' fields) and prints it.
+
+Usage: .venv/bin/python studies/bench_air_heat.py OUT.json [--field PATH --spacing M] [--replay RUN]
 """
 
 from __future__ import annotations
@@ -88,7 +102,7 @@ def _updates(heat: AirHeat, x: np.ndarray, g: np.ndarray, temperature: np.ndarra
              step: np.ndarray, before: bool) -> tuple[list[float], list[int], np.ndarray]:
     """UPDATES updates as the loop makes them; the wall time of each and its iterations."""
     if before:
-        heat.preconditioner = "incomplete LU"
+        heat.preconditioner = {"particles": "incomplete LU", "transport": "incomplete LU"}
     walls, iterations = [], []
     field = np.zeros(heat.cells)
     for k in range(UPDATES):
@@ -132,17 +146,91 @@ def bench(name: str, grid: Grid) -> dict[str, Any]:
     return out
 
 
+def _replay_systems(run: Path) -> tuple[AirHeat, list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]],
+                                         float]:
+    """The run's grid of air that warms and, per snapshot, the particles' drum-frame positions,
+    velocities, film conductances (W/K, per parcel) and temperatures; the seconds per update."""
+    from drumflow.coupling.driver import load_field
+    from drumflow.physics.drum_frame import rotate_to_drum_frame
+
+    spec = json.loads((run / "dem" / "coupling.json").read_text())
+    field = load_field(spec["field"])
+    phases = getattr(field, "fields", None)
+    grid = phases[0] if phases else field
+    if not isinstance(grid, AirField):
+        raise SystemExit(f"--replay {run}: its air is not on a grid")
+    warm = spec["warming"]
+    heat = AirHeat(coarse_field(grid, float(warm["spacing"])), float(spec["air_temperature_C"]),
+                   float(warm["density"]), float(warm["heat_capacity"]))
+    air = AirState.at(float(spec["air_temperature_C"]), float(spec["air_pressure_kPa"]))
+    k = float(spec["coarse_grain"])
+    dt = float(spec["time_step"])
+    snaps = sorted((run / "dem" / "dumps").glob("snap.*.npz"))[2::3]  # a few, spread over the run
+    systems = []
+    for path in snaps:
+        z = np.load(path)
+        x = np.column_stack([z["c_x"], z["c_y"], z["c_z"]]).astype(float)
+        v = np.column_stack([z["c_vx"], z["c_vy"], z["c_vz"]]).astype(float)
+        d = 2.0 * z["c_radius"].astype(float) / k
+        t = int(z["step"]) * dt
+        u = field.sample_at(x, t) if phases else field.sample(x)
+        g = ranz_marshall_h(np.linalg.norm(u - v, axis=1), d, air) * np.pi * d**2 * k**3
+        angle = field.phase(t)[1] if phases else float(spec["omega"]) * t
+        systems.append((rotate_to_drum_frame(x, angle), rotate_to_drum_frame(v, angle), g,
+                        z["c_T"].astype(float)))
+    return heat, systems, int(spec["interval"]) * dt
+
+
+def bench_replay(run: Path) -> dict[str, Any]:
+    """The two arms on the run's own systems, interleaved per snapshot."""
+    heat0, systems, seconds = _replay_systems(run)
+    rng = np.random.default_rng(11)
+    arms: dict[str, dict[str, list[float]]] = {a: {"wall": [], "iterations": []}
+                                               for a in ("one switch", "per system")}
+    difference = 0.0
+    for x, v, g, temperature in systems:
+        factors = rng.uniform(0.95, 1.05, (UPDATES, len(g)))
+        fields = {}
+        for arm in arms:
+            heat = AirHeat(heat0.field, heat0.inlet_temperature_C, heat0.rho_cp, 1.0)
+            for k in range(UPDATES):
+                t0 = time.perf_counter()
+                if arm == "one switch" and "incomplete LU" in heat.preconditioner.values():
+                    heat.preconditioner = {"particles": "incomplete LU", "transport": "incomplete LU"}
+                cells = heat.cells_of(x + k * seconds * v)
+                air = heat.solve_with_particles(heat.deposit(cells, g), heat.deposit(cells, g * temperature))
+                first = heat.iterations
+                given = g * (temperature - air[cells]) * factors[k]
+                fields[arm] = heat.solve(heat.deposit(cells, given))
+                arms[arm]["wall"].append(time.perf_counter() - t0)
+                arms[arm]["iterations"].append(first + heat.iterations)
+        difference = max(difference, float(np.abs(fields["one switch"] - fields["per system"]).max()))
+    out: dict[str, Any] = {"grid": f"replay of {run}", "cells": heat0.cells,
+                           "particles": len(systems[0][2]), "snapshots": len(systems),
+                           "updates_per_snapshot": UPDATES}
+    for arm, data in arms.items():
+        out[arm] = {"median_update_s": statistics.median(data["wall"]),
+                    "min_update_s": min(data["wall"]), "max_update_s": max(data["wall"]),
+                    "median_iterations_per_update": statistics.median(data["iterations"])}
+    out["speedup_median"] = out["one switch"]["median_update_s"] / out["per system"]["median_update_s"]
+    out["largest_field_difference_K"] = difference
+    return out
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("out", type=Path)
     parser.add_argument("--field", type=Path)
     parser.add_argument("--spacing", type=float, default=0.053)
+    parser.add_argument("--replay", type=Path, help="a run of air that warms (its dem/ and snapshots)")
     args = parser.parse_args()
     rng = np.random.default_rng(7)
     results = [bench("curtain_fig4 duct, parcels of 4 grains", _curtain(rng))]
     if args.field is not None:
         drum = _drum(args.field, args.spacing, rng)
         results.append(bench(f"drum field {args.field} at {args.spacing} m", drum))
+    if args.replay is not None:
+        results.append(bench_replay(args.replay))
     record = {"what": "one air update of air that warms (two solves), before and now, interleaved",
               "machine": {"cpu": cpu_model(), "platform": platform.platform()},
               "note": "idle machine required: the arms are interleaved, but a busy core moves both",

@@ -26,8 +26,14 @@ OpenFOAM solution resampled, or plug flow), with the air's own flow, at every ai
   curtain scene's duct with 22,000 parcels 0.018 s against 0.113 s for the incomplete LU of the
   transport from the inlet temperature (which leaves the particles out of the preconditioner),
   on model two's 0.053 m grid (50,800 cells) with a moving bed 0.078 s against 2.58 s (11
-  iterations against 79). Should the lines not converge, the incomplete LU takes over for the
-  rest of the run.
+  iterations against 79). Should the lines not converge on a system, the incomplete LU of the
+  transport takes over for the rest of the run on that system only: the transport alone (the
+  bookkeeping's system) has no particles on its diagonal, and where the air stands nearly still
+  (inside a bed the air goes around, on a grid of a few cells along the axis) the lines miss
+  the cross-flow that then carries the heat; the incomplete LU, built once, takes a few
+  iterations from the implicit solve's field, while the implicit solve keeps its lines (in
+  model one's first run of air around the bed one switch moved both systems, and every update
+  then took some 70 iterations of the incomplete LU: studies/bench_air_heat.py --replay).
   Each solve starts from the last one's field: the bookkeeping's solve (the heat the particles
   actually gave, as a source) follows the implicit one on the same system when the particles
   are lumped, so it starts converged.
@@ -134,10 +140,12 @@ class AirHeat:
         keep = self._reachable(int(fluid.sum()), faces, outlet[0])
         self._keep(keep, faces, inlet, outlet)
         #: The last solve's field (the next one starts from it), its BiCGSTAB iterations and the
-        #: preconditioner in use ("lines", or "incomplete LU" once the lines have failed).
+        #: preconditioner in use for each system, the particles' implicit one ("particles") and
+        #: the transport alone ("transport"): "lines", or "incomplete LU" once the lines have
+        #: failed on that system.
         self._last: NDArray[np.float64] | None = None
         self.iterations = 0
-        self.preconditioner = "lines"
+        self.preconditioner = {"particles": "lines", "transport": "lines"}
 
     # -- set-up --------------------------------------------------------------------------
     def nodes_xyz(self) -> NDArray[np.float64]:
@@ -306,7 +314,7 @@ class AirHeat:
             self._ilu = LinearOperator((self.cells, self.cells), ilu.solve)
         return self._ilu
 
-    def _solve(self, matrix: sp.csr_matrix, rhs: NDArray[np.float64],
+    def _solve(self, system: str, matrix: sp.csr_matrix, rhs: NDArray[np.float64],
                added_diagonal: NDArray[np.float64] | None = None) -> NDArray[np.float64]:
         # Relative residual 1e-12: the conservation of the air's enthalpy holds to that. The
         # start is the last solve's field (the same criterion from a closer start: fewer
@@ -317,12 +325,18 @@ class AirHeat:
         def counted(_: NDArray[np.float64]) -> None:
             count[0] += 1
 
+        # A start that already solves the system (the lumped particles' bookkeeping) is the
+        # answer: no preconditioner is built for it.
+        if np.linalg.norm(rhs - matrix @ start) <= 1e-12 * np.linalg.norm(rhs):
+            self.iterations = 0
+            self._last = np.asarray(start, dtype=float)
+            return self._last.copy()
         info = 1
-        if self.preconditioner == "lines":
+        if self.preconditioner[system] == "lines":
             x, info = bicgstab(matrix, rhs, x0=start, rtol=1e-12, atol=0.0, maxiter=LINE_ITERATIONS,
                                M=self._lines(added_diagonal), callback=counted)
             if info != 0:
-                self.preconditioner = "incomplete LU"  # for the rest of the run
+                self.preconditioner[system] = "incomplete LU"  # for the rest of the run
         if info != 0:
             x, info = bicgstab(matrix, rhs, x0=start, rtol=1e-12, atol=0.0, maxiter=1000,
                                M=self._incomplete_lu(), callback=counted)
@@ -334,7 +348,8 @@ class AirHeat:
 
     def solve(self, source_W: NDArray[np.float64]) -> NDArray[np.float64]:
         """The steady air temperature of each cell, C, for given heat sources, W."""
-        return self._solve(self._transport, self._inlet_rhs() + np.asarray(source_W, dtype=float))
+        return self._solve("transport", self._transport,
+                           self._inlet_rhs() + np.asarray(source_W, dtype=float))
 
     def solve_with_particles(self, conductance_W_K: NDArray[np.float64],
                              weighted_temperature_W: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -349,7 +364,7 @@ class AirHeat:
         conductance = np.asarray(conductance_W_K, dtype=float)
         matrix = self._transport + sp.diags(conductance)
         rhs = self._inlet_rhs() + np.asarray(weighted_temperature_W, dtype=float)
-        return self._solve(matrix.tocsr(), rhs, conductance)
+        return self._solve("particles", matrix.tocsr(), rhs, conductance)
 
     def enthalpy_gain(self, temperature_C: NDArray[np.float64]) -> float:
         """What the air carries out of the grid above what it brought in, W (the outlet's

@@ -5,7 +5,8 @@
 settings study's baseline (:mod:`drumflow.bench.settings`: the run's own deck, ``steps`` DEM
 steps through the real coupling loop, drag and heat included) with each build;
 ``--levels`` runs it at each physics level the run has (one-way lumped; heat inside the
-granule; and air that warms), by leaving the later levels' parts out of the loop's input.
+granule; air that warms; and air around the bed), by leaving the later levels' parts out of the
+loop's input (and, below the air around the bed, by giving the loop the empty drum's air).
 Each arm runs once per repeat, in the order A-B-A-B-A-B, so that a slow stretch of the machine
 falls on every arm alike rather than on whichever ran second. Written: ``builds.csv`` or
 ``levels.csv`` (one row per run: arm, repeat, wall seconds, particle-steps per second, the load
@@ -82,6 +83,9 @@ class Arm:
         The LIGGGHTS the loop loads.
     drop
         Keys of the run's coupling-loop input left out (a physics level's parts).
+    one_way_field
+        The air field the arm's loop samples instead of the run's (the levels below the air
+        around the bed fly through the empty drum's one-way air, ``air/field.npz``).
     same_physics
         Whether the end state must match the first arm's (builds) or may not (levels).
     """
@@ -91,6 +95,7 @@ class Arm:
     build: LiggghtsBuild = DEBIAN_LIGGGHTS
     drop: tuple[str, ...] = ()
     same_physics: bool = True
+    one_way_field: Path | None = None
 
 
 @dataclass(frozen=True)
@@ -148,16 +153,28 @@ def level_arms(driver: dict[str, Any], run_dir: Path) -> list[Arm]:
     ------
     SettingsStudyError
         The run has no level above the paper's (neither ``particles.interior = "shells"`` nor
-        ``air.warming``).
+        ``air.warming``), or has air around the bed without the empty drum's air beside it.
     """
+    # A run of air around the bed (its field the bed states' phases): the levels below it take
+    # the empty drum's one-way air, which the run solved first and kept beside them.
+    around = (driver.get("field") or {}).get("kind") == "phases"
+    empty = run_dir / "air" / "field.npz" if around else None
+    if empty is not None and not empty.is_file():
+        raise SettingsStudyError(f"--levels: {run_dir} has air around the bed but not the empty "
+                                 f"drum's air {empty} that the levels below it fly through")
     arms = [Arm("one-way lumped", "the paper's level: one temperature per particle, air at the "
-                "inlet temperature", drop=(_INTERIOR, _WARMING), same_physics=False)]
+                "inlet temperature", drop=(_INTERIOR, _WARMING), same_physics=False,
+                one_way_field=empty)]
     if _INTERIOR in driver:
         arms.append(Arm("shells", "heat inside the granule (particles.interior = 'shells')",
-                        drop=(_WARMING,), same_physics=False))
+                        drop=(_WARMING,), same_physics=False, one_way_field=empty))
     if _WARMING in driver:
         arms.append(Arm("shells + warming" if _INTERIOR in driver else "warming",
-                        "and air that warms (air.warming = true)", same_physics=False))
+                        "and air that warms (air.warming = true)", same_physics=False,
+                        one_way_field=empty))
+    if around and _WARMING in driver:
+        arms.append(Arm("air around the bed", "and the air of the bed's states, which goes around "
+                        "the bed (air.bed_states)", same_physics=False))
     if len(arms) == 1:
         raise SettingsStudyError(f"--levels: {run_dir} was run at the paper's level only; give a run "
                                  "with particles.interior = 'shells' and/or air.warming = true")
@@ -290,7 +307,9 @@ def run_arms(case: Case, run_dir: Path, out: Path, arms: Sequence[Arm] | None = 
         "deck": deck_source, "order": "interleaved: each repeat runs every arm once, in the order given",
         "busy_other_cores": BUSY_OTHER_CORES,
         "arms": {a.name: {"description": a.description, "build": a.build.describe(),
-                          "left_out_of_the_loop": list(a.drop)} for a in chosen},
+                          "left_out_of_the_loop": list(a.drop),
+                          "air_field": str(a.one_way_field) if a.one_way_field else "the run's"}
+                 for a in chosen},
         "machine": machine_info(Runner(), ranks),
     }
     rows: list[dict[str, Any]] = []
@@ -316,6 +335,8 @@ def run_arms(case: Case, run_dir: Path, out: Path, arms: Sequence[Arm] | None = 
                 on_run(arm.name, repeat, index, total, None)
             folder = scratch / f"{repeat}_{position}"
             spec = {k: v for k, v in driver.items() if k not in arm.drop}
+            if arm.one_way_field is not None:
+                spec["field"] = {"kind": "grid", "path": str(arm.one_way_field.resolve())}
             prepare_variant(folder, rundir, restart, deck, spec, start + steps, 1.0, start)
             busy0, own0 = machine_busy_cpu_s(), children_cpu_s()
             runner = Runner(_profile_for(arm.build))

@@ -82,7 +82,8 @@ def bench(
     ] = None,
     levels: Annotated[
         bool, typer.Option("--levels", help="with --from: the run's physics levels side by side, "
-                           "interleaved (one-way lumped, shells, air that warms): their cost")
+                           "interleaved (one-way lumped, shells, air that warms, air around the "
+                           "bed): their cost")
     ] = False,
     repeats: Annotated[
         int, typer.Option("--repeats", min=1, max=20, help="with --builds or --levels: runs of each")

@@ -124,6 +124,22 @@ def test_level_arms_follow_what_the_run_has(tmp_path: Path) -> None:
         level_arms({"interval": 10}, tmp_path)
 
 
+def test_levels_of_air_around_the_bed_fly_the_lower_levels_through_the_empty_drum(tmp_path: Path) -> None:
+    """A run of air around the bed: its own air is the bed states' phases, the levels below it
+    take the empty drum's one-way air the run kept (air/field.npz), and without it the bench
+    refuses by name."""
+    around = {"interval": 10, "interior": {"shells": 5}, "warming": {"spacing": 0.05},
+              "field": {"kind": "phases", "paths": ["x.npz"], "angles": [0.0]}}
+    with pytest.raises(SettingsStudyError, match="field.npz"):
+        level_arms(around, tmp_path)
+    (tmp_path / "air").mkdir()
+    (tmp_path / "air" / "field.npz").write_bytes(b"")
+    arms = level_arms(around, tmp_path)
+    assert [a.name for a in arms] == ["one-way lumped", "shells", "shells + warming", "air around the bed"]
+    assert [a.one_way_field for a in arms] == [tmp_path / "air" / "field.npz"] * 3 + [None]
+    assert arms[-1].drop == ()
+
+
 def test_builds_describe_their_flags(tmp_path: Path) -> None:
     arms = build_arms(["debian", str(_fake_build(tmp_path / "n", flags="g++ 12 -O3\nmore"))])
     assert arms[0].description.startswith("the Debian package")
