@@ -16,7 +16,8 @@ holds the prediction written first): the mean temperature at 3.5 s; h by the pap
 3.5 s (the interior log; 0 for lumped particles); the air's outlet temperature if it took the
 heat of the slice (one-way air does not warm: this is what it would reach), and the volumetric
 coefficient Q / (V (T_particles - T_air)) of the slice over 1 s to the end, beside the plant's
-~290 W/(m3 K); the DEM wall time over every attempt of the run (its coupling logs). Written: OUT/levels_model_X.csv and .json.
+~290 W/(m3 K); the DEM wall time over every attempt of the run (its coupling logs). Written:
+OUT/levels_model_X.csv and .json.
 """
 
 from __future__ import annotations

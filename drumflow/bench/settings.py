@@ -118,8 +118,14 @@ def restart_file(rundir: RunDir, step: int | None) -> tuple[Path, int]:
 def baseline_deck(rundir: RunDir, restart_step: int, ranks: int, scratch: Path,
                   driver: dict[str, Any]) -> tuple[str, str]:
     """The deck every variant starts from, reading ``input/drum.STEP.restart``, on the default
-    processor grid for ``ranks``; and where it came from."""
-    case = load_case(rundir.case_toml)
+    processor grid for ``ranks``; and where it came from.
+
+    A rendered deck is the DEM's case (the parcels of a coarse-grained case, as the run's DEM
+    stage renders it) at the run's own time step (the loop's input ``time_step``). Regression:
+    rendered from the particles' case, model one's parcels of 2 got half the run's time step
+    (5.78e-5 s for 1.156e-4 s), so the loop's heat per update was twice the DEM's time.
+    """
+    case = load_case(rundir.case_toml).dem_case()
     restart = f"{RESTART_INPUT}/drum.{restart_step}.restart"
     resume_deck = rundir.dem / "in.drum.resume"
     if resume_deck.is_file():
@@ -146,7 +152,9 @@ def baseline_deck(rundir: RunDir, restart_step: int, ranks: int, scratch: Path,
     source.dem.mkdir(parents=True, exist_ok=True)
     fake_restart = source.dem / restart  # only its name goes into the deck
     deck_name, _ = write_deck(case, source, inputs, (fake_restart, restart_step))
-    return (source.dem / deck_name).read_text(), "rendered from the case (drumflow.dem.stage.write_deck)"
+    deck = replace_deck_line((source.dem / deck_name).read_text(), r"^timestep\s+.*$",
+                             f"timestep        {float(driver['time_step']):.12g}")
+    return deck, "rendered from the case (drumflow.dem.stage.write_deck) at the run's time step"
 
 
 def variant_clock(deck: str, start_step: int, start_time: float) -> str:

@@ -115,3 +115,30 @@ def test_the_tangential_damping_diagnostic_edits_the_pair_style_only() -> None:
     assert walls in edited and _coefficients(edited) == (0.1205, 0.313)
     with pytest.raises(SettingsStudyError, match="pair_style"):
         apply_variant(_deck(1.2e-4, 0.1205, 0.313), variant, 2, case)
+
+
+def test_a_rendered_baseline_deck_is_the_parcels_at_the_runs_time_step(tmp_path: Path) -> None:
+    """Regression: the bench rendered a coarse-grained run's deck from the particles' case, so
+    model one's parcels of 2 ran at half the run's time step (5.78e-5 s for 1.156e-4 s) and the
+    loop gave them twice the DEM's time of heat per update. The deck is the DEM's case (the
+    parcels: their time step, their snapshot stride) at the step the loop's input names."""
+    from drumflow.bench.settings import baseline_deck
+    from drumflow.case import case_to_toml
+    from drumflow.geometry.stage import build_geometry
+    from drumflow.rundir import RunDir
+    from drumflow.verify.scenes import tiny_drum
+
+    case = tiny_drum(air__model="uniform", air__mass_flow=0.1, particles__coarse_grain=1.5)
+    run = RunDir(tmp_path / "run")
+    run.bind_case(case.canonical_json(), case.hash(), case_to_toml(case))
+    build_geometry(case.dem_case(), run)
+    choice, plan = plan_run(case.dem_case())
+    assert plan_run(case)[0].time_step < 0.7 * choice.time_step  # the particles' step is shorter
+    driver = {"field": {"kind": "uniform", "velocity": [0.0, 0.0, -1.0]}, "interval": 10,
+              "air_temperature_C": 30.0, "air_pressure_kPa": 101.3, "omega": 1.0,
+              "coarse_grain": 1.5, "time_step": choice.time_step}
+    deck, source = baseline_deck(run, 100, 1, tmp_path / "scratch", driver)
+    steps = [float(m) for m in re.findall(r"^timestep\s+(\S+)\s*$", deck, flags=re.M)]
+    assert steps == [pytest.approx(choice.time_step, rel=1e-9)]
+    assert re.search(rf"^dump\s+snap\s+all\s+custom\s+{plan.snapshot_every}\s", deck, flags=re.M)
+    assert "the run's time step" in source
