@@ -23,9 +23,9 @@ OpenFOAM solution resampled, or plug flow), with the air's own flow, at every ai
   flow) and the particles' conductance exactly, leaving the cross-flow and conduction to the
   iteration. Measured side by side (``studies/bench_air_heat.py``,
   ``results/bench/air_heat/results.json``: one update, both solves, median of 60): on the
-  curtain scene's duct with 22,000 parcels 0.018 s against 0.113 s for the incomplete LU of the
+  curtain scene's duct with 22,000 parcels 0.015 s against 0.108 s for the incomplete LU of the
   transport from the inlet temperature (which leaves the particles out of the preconditioner),
-  on model two's 0.053 m grid (50,800 cells) with a moving bed 0.078 s against 2.58 s (11
+  on model two's 0.053 m grid (50,800 cells) with a moving bed 0.068 s against 2.31 s (11
   iterations against 79). Should the lines not converge on a system, the incomplete LU of the
   transport takes over for the rest of the run on that system only: the transport alone (the
   bookkeeping's system) has no particles on its diagonal, and where the air stands nearly still
@@ -33,7 +33,8 @@ OpenFOAM solution resampled, or plug flow), with the air's own flow, at every ai
   the cross-flow that then carries the heat; the incomplete LU, built once, takes a few
   iterations from the implicit solve's field, while the implicit solve keeps its lines (in
   model one's first run of air around the bed one switch moved both systems, and every update
-  then took some 70 iterations of the incomplete LU: studies/bench_air_heat.py --replay).
+  then took some 70 iterations of the incomplete LU: 1.31 s per update against 0.125 s, replayed
+  on that run's grid and particles, ``studies/bench_air_heat.py --replay``).
   Each solve starts from the last one's field: the bookkeeping's solve (the heat the particles
   actually gave, as a source) follows the implicit one on the same system when the particles
   are lumped, so it starts converged.

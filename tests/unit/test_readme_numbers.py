@@ -114,6 +114,8 @@ TYPED: list[tuple[str, str, str, str]] = [
      "level=around_bed:volumetric_coefficient_lmtd_W_m3K", ",.0f"),
     ("([8,880] s on this VM", "results/paper/levels/runs/paper_model_one_around_bed_cg2_1phase/"
      "summary.json", "wall_time_s", ",.0f"),
+    ("the level now costs [1.06] times one-way", "results/bench/paper_model_one_levels_around_bed_cg2/"
+     "levels.json", "summary.air around the bed.loop_cost_vs_first", ".2f"),
 ]
 
 
@@ -208,3 +210,12 @@ def test_the_papers_mesh_spread() -> None:
                                ".2f", row={"time_s": 3.50042208}))
     mesh1 = PAPER_MODELS["one"].mean_temperature_3p5s_mesh1_C
     assert f"{ours - mesh1:.2f} K from its mesh-1 value ({mesh1:.2f})" in flat
+
+
+def test_the_loops_air_solve_speed_up() -> None:
+    """'since made 10 times faster': the replay of model one's run of air around the bed, one
+    preconditioner switch against one per system (results/bench/air_heat)."""
+    replay = [r for r in _json("results/bench/air_heat/results.json")["results"]
+              if r["grid"].startswith("replay of")]
+    assert len(replay) == 1
+    assert f"since made {replay[0]['speedup_median']:.0f} times faster" in README.replace("\n  ", " ")
