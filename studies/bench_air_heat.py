@@ -122,6 +122,19 @@ def _updates(heat: AirHeat, x: np.ndarray, g: np.ndarray, temperature: np.ndarra
     return walls, iterations, field
 
 
+def _arms_summary(arms: dict[str, dict[str, list[float]]]) -> dict[str, Any]:
+    """Per arm the median and range of the wall time per update and the median iterations; the
+    first arm's median over the second's."""
+    out: dict[str, Any] = {}
+    for arm, data in arms.items():
+        out[arm] = {"median_update_s": statistics.median(data["wall"]),
+                    "min_update_s": min(data["wall"]), "max_update_s": max(data["wall"]),
+                    "median_iterations_per_update": statistics.median(data["iterations"])}
+    first, second = list(arms)
+    out["speedup_median"] = out[first]["median_update_s"] / out[second]["median_update_s"]
+    return out
+
+
 def bench(name: str, grid: Grid) -> dict[str, Any]:
     field, inlet, x, g, temperature, step = grid
     arms: dict[str, dict[str, list[float]]] = {"before": {"wall": [], "iterations": []},
@@ -137,11 +150,7 @@ def bench(name: str, grid: Grid) -> dict[str, Any]:
             arms[arm]["iterations"] += iterations
     out: dict[str, Any] = {"grid": name, "cells": int(cells),
                            "particles": len(x), "updates_per_round": UPDATES, "rounds": ROUNDS}
-    for arm, data in arms.items():
-        out[arm] = {"median_update_s": statistics.median(data["wall"]),
-                    "min_update_s": min(data["wall"]), "max_update_s": max(data["wall"]),
-                    "median_iterations_per_update": statistics.median(data["iterations"])}
-    out["speedup_median"] = out["before"]["median_update_s"] / out["now"]["median_update_s"]
+    out.update(_arms_summary(arms))
     out["largest_field_difference_K"] = float(np.abs(fields["before"] - fields["now"]).max())
     return out
 
@@ -208,11 +217,7 @@ def bench_replay(run: Path) -> dict[str, Any]:
     out: dict[str, Any] = {"grid": f"replay of {run}", "cells": heat0.cells,
                            "particles": len(systems[0][2]), "snapshots": len(systems),
                            "updates_per_snapshot": UPDATES}
-    for arm, data in arms.items():
-        out[arm] = {"median_update_s": statistics.median(data["wall"]),
-                    "min_update_s": min(data["wall"]), "max_update_s": max(data["wall"]),
-                    "median_iterations_per_update": statistics.median(data["iterations"])}
-    out["speedup_median"] = out["one switch"]["median_update_s"] / out["per system"]["median_update_s"]
+    out.update(_arms_summary(arms))
     out["largest_field_difference_K"] = difference
     return out
 
